@@ -1,0 +1,3 @@
+from archmetrics.cli import main
+
+raise SystemExit(main())

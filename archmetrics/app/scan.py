@@ -1,0 +1,84 @@
+"""The ``scan`` use case: measure one snapshot, per file and per function."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+
+from archmetrics.app.collect import parse_all, select
+from archmetrics.app.progress import Progress
+from archmetrics.complexity import file_metrics, totals
+from archmetrics.config import Settings
+from archmetrics.parsers import LanguageTable
+from archmetrics.reports.model import ScanReport
+from archmetrics.sources import SourceError, open_snapshot
+from archmetrics.sources.snapshot import DirectorySnapshot, Snapshot
+
+
+@dataclass(frozen=True, slots=True)
+class ScanRequest:
+    """What to measure: ``paths`` on disk (files or folders), optionally at git revision ``rev``."""
+
+    paths: tuple[Path, ...]
+    rev: str | None
+    settings: Settings
+    jobs: int = 0
+
+
+def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
+    """The root, the snapshot and the path prefixes (relative to root) to keep."""
+    from archmetrics.sources import git
+
+    targets = [p.resolve() for p in request.paths] or [Path.cwd().resolve()]
+    for target in targets:
+        if not target.exists() and request.rev is None:
+            raise SourceError(f"{target}: no such file or directory")
+    anchor = targets[0] if targets[0].is_dir() else targets[0].parent
+    if request.rev is None and not git.is_repository(anchor):
+        if len(targets) == 1 and targets[0].is_dir():
+            return targets[0], DirectorySnapshot(targets[0]), ()
+        root = Path(os.path.commonpath([str(t) for t in targets]))
+        root = root if root.is_dir() else root.parent
+        return root, DirectorySnapshot(root), tuple(_relative(t, root) for t in targets)
+    repo = git.open_repository(anchor)
+    root = git.toplevel(repo).resolve()
+    snapshot = open_snapshot(root, request.rev)
+    prefixes = tuple(_relative(t, root) for t in targets)
+    return root, snapshot, tuple(p for p in prefixes if p)
+
+
+def _relative(target: Path, root: Path) -> str:
+    try:
+        return target.relative_to(root).as_posix() if target != root else ""
+    except ValueError as error:
+        raise SourceError(f"{target}: not under {root}") from error
+
+
+def _under(path: str, prefixes: tuple[str, ...]) -> bool:
+    if not prefixes:
+        return True
+    pure = PurePosixPath(path)
+    return any(path == p or pure.is_relative_to(p) for p in prefixes)
+
+
+def run_scan(request: ScanRequest, progress: Progress | None = None) -> ScanReport:
+    """Facts and metrics for every source file under the requested paths."""
+    root, snapshot, prefixes = _locate(request)
+    overrides = request.settings.languages
+    table = LanguageTable.default(dict(overrides))
+    selected = select(snapshot, table, lambda path: _under(path, prefixes))
+    if request.paths and not selected and request.rev is not None:
+        known = {f.path for f in snapshot.files()}
+        missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
+        if missing:
+            raise SourceError(f"{missing[0]}: no such path at revision {request.rev}")
+    facts = parse_all(snapshot, selected, overrides, request.jobs or request.settings.jobs, progress)
+    metrics = tuple(file_metrics(f) for f in facts)
+    return ScanReport(
+        root=str(root),
+        revision=snapshot.label,
+        facts=facts,
+        files=metrics,
+        totals=totals(metrics),
+    )

@@ -1,0 +1,151 @@
+"""Settings from ``archmetrics.toml`` or ``[tool.archmetrics]`` in ``pyproject.toml``.
+
+The files are read once, at the edge, into one frozen :class:`Settings`; the CLI lays its flags
+over it. An unknown key or a value of the wrong type is an error naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+CONFIG_FILES = ("archmetrics.toml", "pyproject.toml")
+
+
+class ConfigError(Exception):
+    """A bad configuration file or value; the message is one line naming file and key."""
+
+
+@dataclass(frozen=True, slots=True)
+class LocationSettings:
+    new: tuple[str, ...] = ()
+    framework: tuple[str, ...] = ()
+    base: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class CouplingSettings:
+    per_file: bool = False
+    include_dirs: tuple[str, ...] = ()
+    ignore_includes: tuple[str, ...] = ("stdio.h", "stdlib.h")
+    ignore_imports: tuple[str, ...] = ("__future__",)
+    rule_packs: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Settings:
+    """Everything configurable, with its defaults. ``source`` names the file it came from."""
+
+    source: str = "(defaults)"
+    languages: tuple[tuple[str, str], ...] = ()  # file ending -> language ("" drops the ending)
+    exclude: tuple[str, ...] = ()
+    include_generated: bool = False
+    locations: LocationSettings = field(default_factory=LocationSettings)
+    coupling: CouplingSettings = field(default_factory=CouplingSettings)
+    gates: tuple[str, ...] = ()
+    cache_path: str | None = None
+    cache: bool = True
+    jobs: int = 0  # 0: one worker per core
+
+
+def _strings(value: Any, where: str) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ConfigError(f"{where}: expected a list of strings")
+    return tuple(value)
+
+
+def _bool(value: Any, where: str) -> bool:
+    if not isinstance(value, bool):
+        raise ConfigError(f"{where}: expected true or false")
+    return value
+
+
+def _table(value: Any, where: str) -> Mapping[str, Any]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: expected a table")
+    return value
+
+
+def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    for key in table:
+        if key not in allowed:
+            raise ConfigError(f"{where}: unknown key {key!r} (known: {', '.join(sorted(allowed))})")
+
+
+def _locations(table: Mapping[str, Any], where: str) -> LocationSettings:
+    _check_keys(table, {"new", "framework", "base"}, where)
+    return LocationSettings(
+        **{key: _strings(value, f"{where}.{key}") for key, value in table.items()}
+    )
+
+
+def _coupling(table: Mapping[str, Any], where: str) -> CouplingSettings:
+    names = {"per-file", "include-dirs", "ignore-includes", "ignore-imports", "rule-packs"}
+    _check_keys(table, names, where)
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        here = f"{where}.{key}"
+        values[key.replace("-", "_")] = (
+            _bool(value, here) if key == "per-file" else _strings(value, here)
+        )
+    return CouplingSettings(**values)
+
+
+def _int(value: Any, where: str) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+        raise ConfigError(f"{where}: expected a non-negative integer")
+    return value
+
+
+def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
+    """Settings from the archmetrics table of a config file (already TOML-decoded)."""
+    known = {"languages", "exclude", "include-generated", "locations", "coupling", "gates",
+             "cache-path", "cache", "jobs"}
+    _check_keys(table, known, source)
+    values: dict[str, Any] = {"source": source}
+    for key, value in table.items():
+        here = f"{source}: {key}"
+        if key == "languages":
+            langs = _table(value, here)
+            for ending, language in langs.items():
+                if not isinstance(language, str):
+                    raise ConfigError(f"{here}.{ending}: expected a language name")
+            values["languages"] = tuple(sorted(langs.items()))
+        elif key in ("exclude", "gates"):
+            values[key] = _strings(value, here)
+        elif key in ("include-generated", "cache"):
+            values[key.replace("-", "_")] = _bool(value, here)
+        elif key == "locations":
+            values["locations"] = _locations(_table(value, here), here)
+        elif key == "coupling":
+            values["coupling"] = _coupling(_table(value, here), here)
+        elif key == "cache-path":
+            if not isinstance(value, str):
+                raise ConfigError(f"{here}: expected a path")
+            values["cache_path"] = value
+        else:
+            values["jobs"] = _int(value, here)
+    return Settings(**values)
+
+
+def load_settings(root: Path) -> Settings:
+    """Settings from the first of ``archmetrics.toml``, ``pyproject.toml`` in ``root`` that has any."""
+    for name in CONFIG_FILES:
+        path = root / name
+        if not path.is_file():
+            continue
+        try:
+            document = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+            raise ConfigError(f"{path}: not valid TOML: {error}") from error
+        if name == "pyproject.toml":
+            table = document.get("tool", {}).get("archmetrics")
+            if table is None:
+                continue
+        else:
+            table = document.get("tool", {}).get("archmetrics", document)
+        return parse_settings(_table(table, str(path)), str(path))
+    return Settings()

@@ -1,0 +1,184 @@
+"""Facts: the frozen, language-neutral record of one source file.
+
+Parsers turn bytes into a :class:`FileFacts`; everything downstream (complexity, coupling,
+change sets, reports) reads only these values. Every fact carries the line span it came
+from, so any number in a report can be traced back to the source lines behind it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+
+class Language(StrEnum):
+    """Languages with a built-in parser. Third-party parsers may add others by name."""
+
+    PYTHON = "python"
+    C = "c"
+    CPP = "cpp"
+
+
+@dataclass(frozen=True, slots=True, order=True)
+class Span:
+    """An inclusive range of 1-based physical lines."""
+
+    start: int
+    end: int
+
+    def __post_init__(self) -> None:
+        if self.start < 1 or self.end < self.start:
+            raise ValueError(f"bad span {self.start}-{self.end}")
+
+    def contains(self, line: int) -> bool:
+        return self.start <= line <= self.end
+
+
+@dataclass(frozen=True, slots=True)
+class Statement:
+    """One logical line of code (λ counts these), as defined on thesis page 103.
+
+    ``kind`` is the syntax node that made it a statement (the rule-table row in
+    docs/metrics.md); ``text`` is the statement's own text with whitespace collapsed and
+    comments removed -- for a compound statement only its header (``if (x > 0)``), for a
+    function only its signature -- so the change-set engine can pair statements across
+    revisions without being fooled by reformatting.
+    """
+
+    kind: str
+    span: Span
+    text: str
+    function: str | None = None  # qualified name of the enclosing function, if any
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """One McCabe decision point (+1 to v_g): ``kind`` names the construct, e.g. ``if``, ``&&``."""
+
+    kind: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class Function:
+    """A function or method. ``complexity`` is McCabe's v_g = 1 + decision points."""
+
+    name: str
+    qualified_name: str
+    span: Span
+    decisions: tuple[Decision, ...]
+    statements: int  # logical statements inside it, its signature included
+
+    @property
+    def complexity(self) -> int:
+        return 1 + len(self.decisions)
+
+
+@dataclass(frozen=True, slots=True)
+class Class:
+    """A class, struct or union definition (C/C++ ``struct`` with a body counts)."""
+
+    name: str
+    qualified_name: str
+    span: Span
+    kind: str = "class"
+
+
+class DependencyKind(StrEnum):
+    INCLUDE = "include"  # #include "file.h"
+    INCLUDE_SYSTEM = "include_system"  # #include <file.h>
+    IMPORT = "import"  # import a.b / from a.b import c
+
+
+@dataclass(frozen=True, slots=True)
+class Dependency:
+    """A static dependency as written in the source: an include or an import.
+
+    For Python, ``target`` is the module named (``a.b`` for ``from a.b import c``, ``""``
+    for ``from . import c``), ``level`` the number of leading dots of a relative import and
+    ``names`` the names imported from it. For C/C++, ``target`` is the include path.
+    """
+
+    target: str
+    kind: DependencyKind
+    span: Span
+    level: int = 0
+    names: tuple[str, ...] = ()
+
+
+Literal = str | int | float | bool | None
+
+
+@dataclass(frozen=True, slots=True)
+class Argument:
+    """One argument at a call site: its literal value when it is a literal, else None.
+
+    ``text`` is the argument's normalized source text, so a reader can see what it was.
+    """
+
+    text: str
+    value: Literal = None
+    is_literal: bool = False
+    keyword: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class CallSite:
+    """A call as written: the raw material for dynamic coupling.
+
+    ``callee`` is the called expression's text (``bus.request``, ``zmq_connect``,
+    ``dynamic_cast``); ``name`` its last component (``request``); ``receiver`` the text
+    before the last ``.``/``->``/``::`` when there is one.
+    """
+
+    callee: str
+    name: str
+    receiver: str | None
+    span: Span
+    arguments: tuple[Argument, ...] = ()
+    function: str | None = None  # qualified name of the enclosing function, if any
+
+
+class Severity(StrEnum):
+    WARNING = "warning"
+    ERROR = "error"
+
+
+@dataclass(frozen=True, slots=True)
+class ParseWarning:
+    """Something that kept a file from being measured in full; names the file and line."""
+
+    path: str
+    line: int
+    message: str
+    severity: Severity = Severity.WARNING
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}: {self.severity}: {self.message}"
+
+
+@dataclass(frozen=True, slots=True)
+class FileFacts:
+    """Everything archmetrics knows about one file version."""
+
+    path: str
+    language: str
+    statements: tuple[Statement, ...] = ()
+    functions: tuple[Function, ...] = ()
+    classes: tuple[Class, ...] = ()
+    dependencies: tuple[Dependency, ...] = ()
+    call_sites: tuple[CallSite, ...] = ()
+    sloc: int = 0  # physical lines that are neither blank nor only comment
+    warnings: tuple[ParseWarning, ...] = ()
+    parsed: bool = True  # False: the parser could not read it at all (reported, not guessed)
+    generated: bool = False  # the file declares itself generated ("@generated", "DO NOT EDIT")
+
+    @property
+    def loc(self) -> int:
+        """Logical lines of code, λ."""
+        return len(self.statements)
+
+    @property
+    def vg(self) -> int:
+        """McCabe complexity of the file: the sum over its functions."""
+        return sum(f.complexity for f in self.functions)

@@ -1,0 +1,153 @@
+"""The language seam: which parser reads which file ending."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import PurePosixPath
+
+from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
+from archmetrics.parsers import text
+
+ParseFunction = Callable[[str, str], FileFacts]
+"""(path, decoded source) -> facts. Decoding and binary checks happen before it is called."""
+
+ENTRY_POINT_GROUP = "archmetrics.languages"
+
+DEFAULT_EXTENSIONS: Mapping[str, str] = {
+    ".py": Language.PYTHON,
+    ".c": Language.C,
+    ".h": Language.CPP,  # headers are C++ unless configured otherwise (C++ parses C headers too)
+    ".cc": Language.CPP,
+    ".cpp": Language.CPP,
+    ".cxx": Language.CPP,
+    ".c++": Language.CPP,
+    ".hh": Language.CPP,
+    ".hpp": Language.CPP,
+    ".hxx": Language.CPP,
+    ".h++": Language.CPP,
+    ".ipp": Language.CPP,
+    ".inl": Language.CPP,
+}
+
+
+class UnknownLanguage(ValueError):
+    """A configured language has no parser."""
+
+
+@dataclass(frozen=True, slots=True)
+class LanguageSpec:
+    """A language: its name and the function that turns its source into facts."""
+
+    name: str
+    parse: ParseFunction
+
+
+def _python(path: str, source: str) -> FileFacts:
+    from archmetrics.parsers import python
+
+    return python.parse(path, source)
+
+
+def _c(path: str, source: str) -> FileFacts:
+    from archmetrics.parsers import c_family
+
+    return c_family.parse(path, source, Language.C)
+
+
+def _cpp(path: str, source: str) -> FileFacts:
+    from archmetrics.parsers import c_family
+
+    return c_family.parse(path, source, Language.CPP)
+
+
+BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
+    LanguageSpec(Language.PYTHON, _python),
+    LanguageSpec(Language.C, _c),
+    LanguageSpec(Language.CPP, _cpp),
+)
+
+
+def _plugin_languages() -> Iterable[LanguageSpec]:
+    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        spec = entry.load()
+        if not isinstance(spec, LanguageSpec):
+            raise TypeError(
+                f"entry point {entry.name!r} in group {ENTRY_POINT_GROUP} must be a LanguageSpec,"
+                f" got {type(spec).__name__}"
+            )
+        yield spec
+
+
+@dataclass(frozen=True, slots=True)
+class LanguageTable:
+    """File endings mapped to languages, and languages to parsers."""
+
+    extensions: tuple[tuple[str, str], ...]
+    languages: tuple[LanguageSpec, ...]
+
+    @classmethod
+    def default(
+        cls, overrides: Mapping[str, str] | None = None, plugins: bool = True
+    ) -> LanguageTable:
+        """The built-in table, with ``overrides`` (ending -> language, "" to drop) applied."""
+        languages = {spec.name: spec for spec in BUILTIN_LANGUAGES}
+        if plugins:
+            languages.update({spec.name: spec for spec in _plugin_languages()})
+        extensions = dict(DEFAULT_EXTENSIONS)
+        for ending, language in (overrides or {}).items():
+            ending = ending if ending.startswith(".") else "." + ending
+            if not language:
+                extensions.pop(ending.lower(), None)
+                continue
+            if language not in languages:
+                known = ", ".join(sorted(languages))
+                raise UnknownLanguage(f"no parser for language {language!r} (known: {known})")
+            extensions[ending.lower()] = language
+        return cls(tuple(sorted(extensions.items())), tuple(languages.values()))
+
+    def language_of(self, path: str) -> str | None:
+        """The language of ``path`` by its ending, or None when it is not source we measure."""
+        suffix = PurePosixPath(path).suffix.lower()
+        for ending, language in self.extensions:
+            if ending == suffix:
+                return language
+        return None
+
+    def spec(self, language: str) -> LanguageSpec:
+        for spec in self.languages:
+            if spec.name == language:
+                return spec
+        raise UnknownLanguage(f"no parser for language {language!r}")
+
+
+def parse_source(path: str, data: bytes, language: str, table: LanguageTable) -> FileFacts:
+    """Facts for one file's bytes. Never raises for bad input: problems become warnings."""
+    if text.is_binary(data):
+        return FileFacts(
+            path=path,
+            language=language,
+            parsed=False,
+            warnings=(ParseWarning(path, 1, "binary file with a source ending; not measured"),),
+        )
+    source, decode_warning = text.decode(path, data)
+    facts = table.spec(language).parse(path, source)
+    extra: list[ParseWarning] = [decode_warning] if decode_warning else []
+    generated = facts.generated or text.declares_generated(source)
+    if not extra and generated == facts.generated:
+        return facts
+    from dataclasses import replace
+
+    return replace(facts, warnings=tuple(extra) + facts.warnings, generated=generated)
+
+
+__all__ = [
+    "DEFAULT_EXTENSIONS",
+    "LanguageSpec",
+    "LanguageTable",
+    "ParseWarning",
+    "Severity",
+    "UnknownLanguage",
+    "parse_source",
+]

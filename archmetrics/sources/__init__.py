@@ -1,0 +1,16 @@
+"""The edges: where file versions come from (a directory, a git revision, the index, the cache).
+
+Everything here reads; nothing here changes a repository, its index or its working tree.
+"""
+
+from archmetrics.sources.snapshot import (
+    EMPTY,
+    INDEX,
+    WORKTREE,
+    SourceError,
+    SourceFile,
+    Snapshot,
+    open_snapshot,
+)
+
+__all__ = ["EMPTY", "INDEX", "WORKTREE", "Snapshot", "SourceError", "SourceFile", "open_snapshot"]

@@ -1,0 +1,112 @@
+"""Snapshots: one version of a tree of files, each file named by its git blob hash."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+EMPTY = "EMPTY"  # the empty tree: a first integration stage has nothing before it
+WORKTREE = "WORKTREE"  # the files on disk, committed or not (untracked ones too, unless ignored)
+INDEX = "INDEX"  # what is staged
+
+SKIP_DIRS = frozenset({".git", ".hg", ".svn", ".venv", "venv", "__pycache__", "node_modules", ".tox"})
+
+
+class SourceError(Exception):
+    """A revision or path that cannot be read; the message is one line for the user."""
+
+
+@dataclass(frozen=True, slots=True, order=True)
+class SourceFile:
+    """A file in a snapshot: its path (POSIX, relative to the snapshot's root) and blob hash."""
+
+    path: str
+    blob: str
+
+
+class Snapshot(Protocol):
+    """One version of a tree. ``label`` is what reports call it (a revision, WORKTREE ...)."""
+
+    @property
+    def label(self) -> str: ...
+
+    def files(self) -> tuple[SourceFile, ...]: ...
+
+    def read(self, file: SourceFile) -> bytes: ...
+
+
+def blob_hash(data: bytes) -> str:
+    """The git blob id of ``data`` (what ``git hash-object`` prints)."""
+    digest = hashlib.sha1(b"blob %d\0" % len(data), usedforsecurity=False)
+    digest.update(data)
+    return digest.hexdigest()
+
+
+@dataclass(frozen=True, slots=True)
+class EmptySnapshot:
+    """The empty tree."""
+
+    label: str = EMPTY
+
+    def files(self) -> tuple[SourceFile, ...]:
+        return ()
+
+    def read(self, file: SourceFile) -> bytes:
+        raise SourceError(f"{file.path}: the empty tree has no files")
+
+
+class DirectorySnapshot:
+    """Files under a directory on disk (outside git, or a working tree read directly)."""
+
+    def __init__(self, root: Path, paths: Iterable[str] | None = None, label: str = WORKTREE):
+        self.root = root
+        self.label = label
+        self._paths = tuple(sorted(paths)) if paths is not None else None
+        self._hashes: dict[str, str] = {}
+
+    def _walk(self) -> Iterable[str]:
+        if self._paths is not None:
+            yield from self._paths
+            return
+        for folder, dirs, names in os.walk(self.root):
+            dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.endswith(".egg-info"))
+            rel = Path(folder).relative_to(self.root)
+            for name in sorted(names):
+                yield (rel / name).as_posix()
+
+    def files(self) -> tuple[SourceFile, ...]:
+        found = []
+        for path in self._walk():
+            full = self.root / path
+            if full.is_file() and not full.is_symlink():
+                found.append(SourceFile(path, self._hashes.get(path, "")))
+        return tuple(found)
+
+    def read(self, file: SourceFile) -> bytes:
+        try:
+            return (self.root / file.path).read_bytes()
+        except OSError as error:
+            raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
+
+
+def open_snapshot(root: Path, spec: str | None, paths: Sequence[str] = ()) -> Snapshot:
+    """The snapshot ``spec`` names in the repository or directory at ``root``.
+
+    ``spec`` is None (the files on disk), ``EMPTY``, ``WORKTREE``, ``INDEX`` or any git revision.
+    """
+    from archmetrics.sources import git
+
+    if spec == EMPTY:
+        return EmptySnapshot()
+    if spec is None and not git.is_repository(root):
+        return DirectorySnapshot(root)
+    repo = git.open_repository(root)
+    if spec is None or spec == WORKTREE:
+        return git.WorktreeSnapshot(repo)
+    if spec == INDEX:
+        return git.IndexSnapshot(repo)
+    return git.RevisionSnapshot(repo, spec)
