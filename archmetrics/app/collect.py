@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import os
+from collections import deque
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.facts import FileFacts
 from archmetrics.parsers import LanguageTable, parse_source
 from archmetrics.sources import Snapshot, SourceFile
+from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.snapshot import blob_hash
 
 PARALLEL_THRESHOLD = 48  # below this many files, a process pool costs more than it saves
 BATCH = 16
@@ -61,45 +64,92 @@ def worker_count(jobs: int) -> int:
         return os.cpu_count() or 1
 
 
+@dataclass(slots=True)
+class _Todo:
+    index: int
+    item: Selected
+    blob: str
+    data: bytes | None
+
+
 def parse_all(
     snapshot: Snapshot,
     selected: Sequence[Selected],
     overrides: tuple[tuple[str, str], ...] = (),
     jobs: int = 0,
     progress: Progress | None = None,
+    cache: FactsCache | None = None,
 ) -> tuple[FileFacts, ...]:
-    """Facts for every selected file, in the order given."""
+    """Facts for every selected file, in the order given: from the cache when it has them."""
     progress = progress or NoProgress()
-    table = LanguageTable.default(dict(overrides))
-    workers = worker_count(jobs)
-    progress.start("parsing", len(selected))
+    results: list[FileFacts | None] = [None] * len(selected)
+    todo: list[_Todo] = []
+    for index, item in enumerate(selected):
+        blob, data = item.file.blob, None
+        if not blob:  # a file on disk: hash it the way git would
+            data = snapshot.read(item.file)
+            blob = blob_hash(data)
+        hit = cache.get(blob, item.language, item.file.path) if cache else None
+        if hit is None:
+            todo.append(_Todo(index, item, blob, data))
+        results[index] = hit
+    progress.start("parsing", len(todo))
     try:
-        if workers == 1 or len(selected) < PARALLEL_THRESHOLD:
-            results = []
-            for item in selected:
-                data = snapshot.read(item.file)
-                results.append(parse_source(item.file.path, data, item.language, table))
-                progress.advance()
-            return tuple(results)
-        return _parse_parallel(snapshot, selected, overrides, workers, progress)
+        parsed = _parse(snapshot, todo, overrides, worker_count(jobs), progress)
     finally:
         progress.stop()
+    for entry, facts in zip(todo, parsed, strict=True):
+        results[entry.index] = facts
+    if cache is not None:
+        cache.put_many((entry.blob, facts) for entry, facts in zip(todo, parsed, strict=True))
+    return tuple(f for f in results if f is not None)
+
+
+def _payload(snapshot: Snapshot, entry: _Todo) -> tuple[str, bytes, str]:
+    data = entry.data if entry.data is not None else snapshot.read(entry.item.file)
+    return entry.item.file.path, data, entry.item.language
+
+
+def _parse(
+    snapshot: Snapshot,
+    todo: Sequence[_Todo],
+    overrides: tuple[tuple[str, str], ...],
+    workers: int,
+    progress: Progress,
+) -> list[FileFacts]:
+    if workers == 1 or len(todo) < PARALLEL_THRESHOLD:
+        table = LanguageTable.default(dict(overrides))
+        results = []
+        for entry in todo:
+            results.append(parse_source(*_payload(snapshot, entry), table))
+            progress.advance()
+        return results
+    return _parse_parallel(snapshot, todo, overrides, workers, progress)
 
 
 def _parse_parallel(
     snapshot: Snapshot,
-    selected: Sequence[Selected],
+    todo: Sequence[_Todo],
     overrides: tuple[tuple[str, str], ...],
     workers: int,
     progress: Progress,
-) -> tuple[FileFacts, ...]:
-    batches = [
-        [(s.file.path, snapshot.read(s.file), s.language) for s in selected[i : i + BATCH]]
-        for i in range(0, len(selected), BATCH)
-    ]
+) -> list[FileFacts]:
+    """Batches go to a process pool; at most a few batches per worker are read ahead, so
+    memory stays bounded however large the tree is."""
+    batches = (todo[i : i + BATCH] for i in range(0, len(todo), BATCH))
     results: list[FileFacts] = []
+    window: deque[Future[list[FileFacts]]] = deque()
     with ProcessPoolExecutor(workers, initializer=_init_worker, initargs=(overrides,)) as pool:
-        for facts in pool.map(_parse_batch, batches):
-            results.extend(facts)
-            progress.advance(len(facts))
-    return tuple(results)
+        for batch in batches:
+            window.append(pool.submit(_parse_batch, [_payload(snapshot, e) for e in batch]))
+            if len(window) >= workers * 3:
+                results.extend(_collect(window.popleft(), progress))
+        while window:
+            results.extend(_collect(window.popleft(), progress))
+    return results
+
+
+def _collect(future: Future[list[FileFacts]], progress: Progress) -> list[FileFacts]:
+    facts = future.result()
+    progress.advance(len(facts))
+    return facts

@@ -7,12 +7,14 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from archmetrics.app.collect import parse_all, select
+from archmetrics.app.coupling import measure
 from archmetrics.app.progress import Progress
 from archmetrics.complexity import file_metrics, totals
 from archmetrics.config import Settings
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import ScanReport
 from archmetrics.sources import SourceError, open_snapshot
+from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import DirectorySnapshot, Snapshot
 
 
@@ -24,6 +26,7 @@ class ScanRequest:
     rev: str | None
     settings: Settings
     jobs: int = 0
+    plain_directory: bool = False  # read the one path given as a folder, even inside git
 
 
 def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
@@ -35,6 +38,8 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
         if not target.exists() and request.rev is None:
             raise SourceError(f"{target}: no such file or directory")
     anchor = targets[0] if targets[0].is_dir() else targets[0].parent
+    if request.plain_directory:
+        return anchor, DirectorySnapshot(anchor), ()
     if request.rev is None and not git.is_repository(anchor):
         if len(targets) == 1 and targets[0].is_dir():
             return targets[0], DirectorySnapshot(targets[0]), ()
@@ -62,7 +67,9 @@ def _under(path: str, prefixes: tuple[str, ...]) -> bool:
     return any(path == p or pure.is_relative_to(p) for p in prefixes)
 
 
-def run_scan(request: ScanRequest, progress: Progress | None = None) -> ScanReport:
+def run_scan(
+    request: ScanRequest, progress: Progress | None = None, cache: FactsCache | None = None
+) -> ScanReport:
     """Facts and metrics for every source file under the requested paths."""
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
@@ -73,7 +80,9 @@ def run_scan(request: ScanRequest, progress: Progress | None = None) -> ScanRepo
         missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
         if missing:
             raise SourceError(f"{missing[0]}: no such path at revision {request.rev}")
-    facts = parse_all(snapshot, selected, overrides, request.jobs or request.settings.jobs, progress)
+    facts = parse_all(
+        snapshot, selected, overrides, request.jobs or request.settings.jobs, progress
+    )
     metrics = tuple(file_metrics(f) for f in facts)
     return ScanReport(
         root=str(root),
@@ -81,4 +90,5 @@ def run_scan(request: ScanRequest, progress: Progress | None = None) -> ScanRepo
         facts=facts,
         files=metrics,
         totals=totals(metrics),
+        coupling=measure(facts, request.settings, root),
     )

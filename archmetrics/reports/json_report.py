@@ -7,7 +7,8 @@ from typing import Any
 
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
-from archmetrics.reports.model import SCAN_SCHEMA, ScanReport
+from archmetrics.reports import coupling_rows
+from archmetrics.reports.model import DIFF_SCHEMA, SCAN_SCHEMA, DiffReport, ScanReport
 
 
 def warning_dict(warning: ParseWarning) -> dict[str, Any]:
@@ -62,6 +63,7 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
         "revision": report.revision,
         "files": [_file(f) for f in report.files],
         "totals": totals_dict(report.totals),
+        "elements": coupling_rows.elements_json(report),
     }
 
 
@@ -71,3 +73,21 @@ def dumps(document: dict[str, Any]) -> str:
 
 def render_scan(report: ScanReport) -> str:
     return dumps(scan_dict(report))
+
+
+def diff_dict(report: DiffReport) -> dict[str, Any]:
+    failed = {f.gate.text for f in report.failures}
+    return {
+        "schema": DIFF_SCHEMA,
+        "base": report.base,
+        "head": report.head,
+        "locations": {name: s.to_dict() for name, s in report.summaries().items()},
+        "elements": [e.to_dict() for e in report.change.elements],
+        "excluded": [x.to_dict() for x in report.change.excluded],
+        "warnings": [warning_dict(w) for w in report.warnings],
+        "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+    }
+
+
+def render_diff(report: DiffReport) -> str:
+    return dumps(diff_dict(report))

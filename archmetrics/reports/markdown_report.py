@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from archmetrics.reports.model import ScanReport
+from archmetrics.reports import coupling_rows, diff_rows
+from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport, ScanReport
 
 
 def escape(cell: object) -> str:
@@ -20,28 +21,64 @@ def table(header: Sequence[str], rows: Iterable[Sequence[object]], align: str = 
     return "\n".join(lines) + "\n"
 
 
-def render_scan(report: ScanReport, by_function: bool) -> str:
+def _scan_table(report: ScanReport, grouping: str) -> str:
     t = report.totals
-    parts = [
-        f"## archmetrics scan: `{report.revision}`\n",
-        f"{t.files} files, {t.functions} functions: λ = {t.loc}, SLOC = {t.sloc}, "
-        f"v_g = {t.vg}\n",
-    ]
-    if by_function:
+    if grouping == "function":
         rows = [
             (f"`{file.path}`", f"`{f.qualified_name}`", f.line, f.loc, f.vg)
             for file in report.files
             for f in file.functions
         ]
-        parts.append(table(["file", "function", "line", "λ", "v_g"], rows, "llrrr"))
-    else:
-        rows2 = [
-            (f"`{f.path}`", f.language, f.loc, f.sloc, f.vg, len(f.functions))
-            for f in report.files
-        ]
-        rows2.append(("**total**", "", t.loc, t.sloc, t.vg, t.functions))
-        parts.append(table(["file", "language", "λ", "SLOC", "v_g", "functions"], rows2, "llrrrr"))
+        return table(["file", "function", "line", "λ", "v_g"], rows, "llrrr")
+    if grouping == "element":
+        header = list(coupling_rows.ELEMENT_HEADER)
+        return table(header, coupling_rows.element_rows(report), "ll" + "r" * 7)
+    if grouping == "link":
+        return table(list(coupling_rows.LINK_HEADER), coupling_rows.link_rows(report.coupling))
+    files: list[tuple[object, ...]] = [
+        (f"`{f.path}`", f.language, f.loc, f.sloc, f.vg, len(f.functions)) for f in report.files
+    ]
+    files.append(("**total**", "", t.loc, t.sloc, t.vg, t.functions))
+    return table(["file", "language", "λ", "SLOC", "v_g", "functions"], files, "llrrrr")
+
+
+def render_scan(report: ScanReport, grouping: str) -> str:
+    t = report.totals
+    parts = [
+        f"## archmetrics scan: `{report.revision}`\n",
+        f"{t.files} files, {t.functions} functions: λ = {t.loc}, SLOC = {t.sloc}, v_g = {t.vg}\n",
+        _scan_table(report, grouping),
+    ]
     warnings = [w for f in report.files for w in f.warnings]
     if warnings:
         parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
+    return "\n".join(parts)
+
+
+def render_diff(report: DiffReport) -> str:
+    """A pull-request comment: verdict line, summary table, changed elements, notes."""
+    total = report.change.total
+    verdict = (
+        f"**{len(report.failures)} gate(s) failed**"
+        if report.failures
+        else ("all gates hold" if report.gates else "no gates configured")
+    )
+    parts = [
+        f"## archmetrics: `{report.base}` → `{report.head}`\n",
+        f"Γ = {total.changes} changed statements, ΔVg = {total.delta_vg}, "
+        f"E = {diff_rows.number(total.cost)} · {verdict}\n",
+        table(["metric", "eq.", *LOCATION_COLUMNS], diff_rows.summary_rows(report), "llrrrr"),
+    ]
+    changed = [e for e in report.change.elements if e.status.value != "unchanged"]
+    if changed:
+        rows = [diff_rows.element_row(e) for e in changed]
+        parts.append(f"<details><summary>{len(changed)} changed elements</summary>\n")
+        parts.append(table(list(diff_rows.ELEMENT_HEADER), rows, "lll" + "r" * 11))
+        parts.append("</details>\n")
+    bullets = [f"- {f}" for f in report.failures]
+    bullets += [f"- note {n}" for n in diff_rows.notes(report)]
+    bullets += [f"- excluded `{x.path}`: {x.reason}" for x in report.change.excluded]
+    bullets += [f"- warning `{w}`" for w in report.warnings]
+    if bullets:
+        parts.append("\n".join(bullets) + "\n")
     return "\n".join(parts)

@@ -4,10 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from archmetrics.changeset.gates import GateFailure
+from archmetrics.changeset.model import ChangeReport, Summary
 from archmetrics.complexity import FileMetrics, Totals
-from archmetrics.facts import FileFacts
+from archmetrics.coupling import CouplingReport
+from archmetrics.facts import FileFacts, ParseWarning
 
 SCAN_SCHEMA = "archmetrics.scan/1"
+DIFF_SCHEMA = "archmetrics.diff/1"
+LOCATION_COLUMNS = ("base", "new", "framework", "total")
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,3 +24,58 @@ class ScanReport:
     facts: tuple[FileFacts, ...]
     files: tuple[FileMetrics, ...]
     totals: Totals
+    coupling: CouplingReport | None = None
+
+    def element_rows(self) -> list[ElementRow]:
+        """Per element: its files, summed λ, SLOC and v_g, and its coupling."""
+        if self.coupling is None:
+            return []
+        by_path = {f.path: f for f in self.files}
+        rows = []
+        for c in self.coupling.elements:
+            files = [by_path[p] for p in c.element.files if p in by_path]
+            rows.append(
+                ElementRow(
+                    c.element.name,
+                    c.element.files,
+                    sum(f.loc for f in files),
+                    sum(f.sloc for f in files),
+                    sum(f.vg for f in files),
+                    c.s_a,
+                    c.s_e,
+                    c.d_a,
+                    c.d_e,
+                )
+            )
+        return rows
+
+
+@dataclass(frozen=True, slots=True)
+class ElementRow:
+    element: str
+    files: tuple[str, ...]
+    loc: int
+    sloc: int
+    vg: int
+    s_a: int
+    s_e: int
+    d_a: int
+    d_e: int
+
+
+@dataclass(frozen=True, slots=True)
+class DiffReport:
+    """Two revisions compared: the chapter-6 metrics, and what could not be measured."""
+
+    base: str
+    head: str
+    change: ChangeReport
+    warnings: tuple[ParseWarning, ...] = ()
+    gates: tuple[str, ...] = ()  # the gate expressions checked
+    failures: tuple[GateFailure, ...] = ()
+
+    def summaries(self) -> dict[str, Summary]:
+        """Per location and the total, keyed base, new, framework, total."""
+        found = {loc.value: summary for loc, summary in self.change.locations}
+        found["total"] = self.change.total
+        return found

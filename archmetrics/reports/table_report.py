@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import io
+import shutil
 
 from rich.console import Console
 from rich.table import Table
 
-from archmetrics.reports.model import ScanReport
+from archmetrics.reports import coupling_rows, diff_rows
+from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport, ScanReport
 
 
-def to_text(*renderables: object, color: bool = False, width: int = 120) -> str:
-    """Render rich objects to a string (ANSI colours only when ``color``)."""
+def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
+    """Render rich objects to a string (ANSI colours only when ``color``), as wide as the
+    terminal, or 160 columns when there is none."""
+    width = width or max(100, shutil.get_terminal_size((160, 24)).columns)
     out = io.StringIO()
     console = Console(file=out, force_terminal=color, width=width, no_color=not color)
     for item in renderables:
@@ -29,7 +33,9 @@ def _file_table(report: ScanReport) -> Table:
     table.add_column("v_g", justify="right", footer=str(t.vg))
     table.add_column("functions", justify="right", footer=str(t.functions))
     for f in report.files:
-        name = f.path + ("" if f.parsed else " (not parsed)") + (" (generated)" if f.generated else "")
+        name = (
+            f.path + ("" if f.parsed else " (not parsed)") + (" (generated)" if f.generated else "")
+        )
         table.add_row(name, f.language, str(f.loc), str(f.sloc), str(f.vg), str(len(f.functions)))
     return table
 
@@ -40,8 +46,9 @@ def _function_table(report: ScanReport) -> Table:
     table.add_column("file", footer="total")
     table.add_column("function", footer=f"{t.functions} functions")
     table.add_column("line", justify="right")
-    table.add_column("λ", justify="right", footer=str(sum(
-        fn.loc for f in report.files for fn in f.functions)))
+    table.add_column(
+        "λ", justify="right", footer=str(sum(fn.loc for f in report.files for fn in f.functions))
+    )
     table.add_column("v_g", justify="right", footer=str(t.vg))
     for f in report.files:
         for fn in f.functions:
@@ -49,8 +56,52 @@ def _function_table(report: ScanReport) -> Table:
     return table
 
 
-def render_scan(report: ScanReport, by_function: bool, color: bool = False) -> str:
-    table = _function_table(report) if by_function else _file_table(report)
+def rows_table(title: str, header: tuple[str, ...], rows: list[list[str]], left: int) -> Table:
+    table = Table(title=title)
+    for i, name in enumerate(header):
+        table.add_column(name, justify="left" if i < left else "right")
+    for row in rows:
+        table.add_row(*row)
+    return table
+
+
+def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
+    if grouping == "function":
+        table = _function_table(report)
+    elif grouping == "element":
+        rows = coupling_rows.element_rows(report)
+        title = f"archmetrics scan by element: {report.revision}"
+        table = rows_table(title, coupling_rows.ELEMENT_HEADER, rows, 2)
+    elif grouping == "link":
+        rows = coupling_rows.link_rows(report.coupling)
+        title = f"archmetrics scan, every link: {report.revision}"
+        table = rows_table(title, coupling_rows.LINK_HEADER, rows, 8)
+    else:
+        table = _file_table(report)
     warnings = [str(w) for f in report.files for w in f.warnings]
     extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
+
+
+def render_diff(report: DiffReport, color: bool = False) -> str:
+    """The per-location summary (thesis appendix tables C-I), then the per-element detail."""
+    summary = Table(title=f"archmetrics diff: {report.base} → {report.head}")
+    summary.add_column("metric")
+    summary.add_column("eq.", style="dim")
+    for column in LOCATION_COLUMNS:
+        summary.add_column(column, justify="right")
+    for row in diff_rows.summary_rows(report):
+        summary.add_row(*row)
+    detail = Table(title="elements")
+    for i, name in enumerate(diff_rows.ELEMENT_HEADER):
+        detail.add_column(name, justify="left" if i < 3 else "right")
+    for element in report.change.elements:
+        if element.status.value != "unchanged":
+            detail.add_row(*diff_rows.element_row(element))
+    unchanged = sum(e.status.value == "unchanged" for e in report.change.elements)
+    lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
+    lines += [f"note {n}" for n in diff_rows.notes(report)]
+    lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
+    lines += [f"warning {w}" for w in report.warnings]
+    lines += [str(f) for f in report.failures]
+    return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)

@@ -7,9 +7,9 @@ from archmetrics.sources.snapshot import (
     EMPTY,
     INDEX,
     WORKTREE,
+    Snapshot,
     SourceError,
     SourceFile,
-    Snapshot,
     open_snapshot,
 )
 

@@ -55,6 +55,19 @@ def resolve(repo: git.Repo, rev: str) -> str:
         raise SourceError(f"unknown revision {rev!r}") from error
 
 
+def has_commits(repo: git.Repo) -> bool:
+    try:
+        repo.head.commit  # noqa: B018 -- raises when HEAD points at no commit yet
+    except ValueError:
+        return False
+    return True
+
+
+def effective_spec(repo: git.Repo, spec: str) -> str:
+    """``spec``, except that HEAD in a repository with no commits yet is the empty tree."""
+    return EMPTY if spec == "HEAD" and not has_commits(repo) else spec
+
+
 def _ls(repo: git.Repo, *args: str) -> list[str]:
     out: str = repo.git.execute(["git", *args], strip_newline_in_stdout=False)
     return [entry for entry in out.split("\0") if entry]
@@ -118,6 +131,7 @@ class WorktreeSnapshot(DirectorySnapshot):
 def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:
     """Paths renamed between two snapshot specs, old -> new, as ``git diff -M`` finds them."""
     args = ["diff", "-M", "--name-status", "-z", "--no-ext-diff", "--diff-filter=R"]
+    base, head = effective_spec(repo, base), effective_spec(repo, head)
     if base == EMPTY or head == EMPTY:
         return {}
     if head == WORKTREE and base == INDEX:

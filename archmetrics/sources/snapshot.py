@@ -13,7 +13,9 @@ EMPTY = "EMPTY"  # the empty tree: a first integration stage has nothing before 
 WORKTREE = "WORKTREE"  # the files on disk, committed or not (untracked ones too, unless ignored)
 INDEX = "INDEX"  # what is staged
 
-SKIP_DIRS = frozenset({".git", ".hg", ".svn", ".venv", "venv", "__pycache__", "node_modules", ".tox"})
+SKIP_DIRS = frozenset(
+    {".git", ".hg", ".svn", ".venv", "venv", "__pycache__", "node_modules", ".tox"}
+)
 
 
 class SourceError(Exception):
@@ -105,6 +107,8 @@ def open_snapshot(root: Path, spec: str | None, paths: Sequence[str] = ()) -> Sn
     if spec is None and not git.is_repository(root):
         return DirectorySnapshot(root)
     repo = git.open_repository(root)
+    if spec is not None and git.effective_spec(repo, spec) == EMPTY:
+        return EmptySnapshot(label=f"{spec} (no commits yet)")
     if spec is None or spec == WORKTREE:
         return git.WorktreeSnapshot(repo)
     if spec == INDEX:

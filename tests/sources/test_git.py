@@ -76,3 +76,11 @@ def test_directory_snapshot_outside_git(tmp_path: Path) -> None:
     snapshot = open_snapshot(tmp_path, None)
     assert isinstance(snapshot, DirectorySnapshot)
     assert [f.path for f in snapshot.files()] == ["pkg/m.py"]
+
+
+def test_head_of_a_repository_without_commits_is_the_empty_tree(repo: GitRepo) -> None:
+    repo.write({"a.py": "x = 1\n"})
+    repo.git("add", "a.py")
+    assert open_snapshot(repo.root, "HEAD").files() == ()
+    assert [f.path for f in open_snapshot(repo.root, INDEX).files()] == ["a.py"]
+    assert renames(open_repository(repo.root), "HEAD", INDEX) == {}

@@ -1,0 +1,139 @@
+"""The ``diff`` use case: two snapshots of a repository in, the chapter-6 metrics out."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from archmetrics.app.collect import parse_all, select
+from archmetrics.app.progress import Progress
+from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
+from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.config import Settings
+from archmetrics.app.coupling import coupling_options, rule_set
+from archmetrics.coupling import CouplingOptions, measure_coupling
+from archmetrics.coupling.rules import RuleSet
+from archmetrics.facts import FileFacts, ParseWarning
+from archmetrics.parsers import LanguageTable
+from archmetrics.reports.model import DiffReport
+from archmetrics.sources import Snapshot, git, open_snapshot
+from archmetrics.sources.cache import FactsCache
+
+
+@dataclass(frozen=True, slots=True)
+class DiffRequest:
+    """Compare ``base`` with ``head`` (revisions, EMPTY, WORKTREE or INDEX) in the repo at root."""
+
+    root: Path
+    base: str
+    head: str
+    settings: Settings
+    new: tuple[str, ...] = ()  # --new globs, ahead of the configured ones
+    framework: tuple[str, ...] = ()
+    gates: tuple[str, ...] = ()  # --fail-on, after the configured ones
+    jobs: int = 0
+    dynamic_pre_zero: bool = False
+
+
+def location_rules(request: DiffRequest) -> LocationRules:
+    """``--new`` and ``--framework`` globs first, then the configured new, framework and base
+    globs, in that order: the first that matches a path decides its location."""
+    configured = request.settings.locations
+    cli = LocationRules.from_mapping({"new": request.new, "framework": request.framework})
+    rest = LocationRules.from_mapping(
+        {"new": configured.new, "framework": configured.framework, "base": configured.base}
+    )
+    return LocationRules(
+        cli.rules + rest.rules, request.settings.exclude, not request.settings.include_generated
+    )
+
+
+def coupling_values(
+    files: Sequence[FileFacts], rules: LocationRules, options: CouplingOptions, packs: RuleSet
+) -> dict[str, Coupling]:
+    """Element name -> (s_a, s_e, d_a, d_e) over the measured (not excluded) files of a tree."""
+    measured = [
+        f
+        for f in files
+        if f.parsed
+        and not rules.is_excluded(f.path)
+        and not (rules.exclude_generated and f.generated)
+    ]
+    report = measure_coupling(measured, options, packs)
+    return {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
+
+
+def pair_files(
+    pre: Sequence[FileFacts], post: Sequence[FileFacts], renames: dict[str, str]
+) -> list[FilePair]:
+    """Files paired across the revisions by path, and by git's renames (old -> new)."""
+    after = {f.path: f for f in post}
+    pairs, taken = [], set()
+    for facts in pre:
+        new_path = renames.get(facts.path, facts.path)
+        if new_path not in after and facts.path in after:
+            new_path = facts.path
+        partner = after.get(new_path)
+        if partner is not None:
+            taken.add(new_path)
+        pairs.append(FilePair(facts, partner))
+    pairs.extend(FilePair(None, f) for f in post if f.path not in taken)
+    return pairs
+
+
+def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+    seen: dict[str, ParseWarning] = {}
+    for side in sides:
+        for facts in side:
+            for w in facts.warnings:
+                seen.setdefault(str(w), w)
+    return tuple(seen.values())
+
+
+def _parse_side(
+    snapshot: Snapshot, request: DiffRequest, progress: Progress | None, cache: FactsCache | None
+) -> tuple[FileFacts, ...]:
+    overrides = request.settings.languages
+    selected = select(snapshot, LanguageTable.default(dict(overrides)))
+    return parse_all(
+        snapshot, selected, overrides, request.jobs or request.settings.jobs, progress, cache
+    )
+
+
+def measure_change(
+    request: DiffRequest, progress: Progress | None = None, cache: FactsCache | None = None
+) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
+    """The change report between the two snapshots, and the parse warnings of both sides."""
+    repo = git.open_repository(request.root)
+    root = git.toplevel(repo)
+    base = open_snapshot(root, request.base)
+    head = open_snapshot(root, request.head)
+    rules = location_rules(request)
+    pre = _parse_side(base, request, progress, cache)
+    post = _parse_side(head, request, progress, cache)
+    options, packs = coupling_options(request.settings), rule_set(request.settings, root)
+    change = compute_change(
+        pair_files(pre, post, git.renames(repo, request.base, request.head)),
+        None,
+        rules,
+        coupling_values(pre, rules, options, packs),
+        coupling_values(post, rules, options, packs),
+        dynamic_pre_zero=request.dynamic_pre_zero,
+    )
+    return change, _warnings(pre, post)
+
+
+def gates_of(request: DiffRequest) -> tuple[Gate, ...]:
+    return tuple(parse_gate(g) for g in (*request.settings.gates, *request.gates))
+
+
+def run_diff(
+    request: DiffRequest, progress: Progress | None = None, cache: FactsCache | None = None
+) -> DiffReport:
+    """Measure, then check the gates."""
+    gates = gates_of(request)  # a bad gate fails before any work
+    change, warnings = measure_change(request, progress, cache)
+    report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
+    failures = check_gates(gates, report.summaries())
+    return DiffReport(report.base, report.head, change, warnings, report.gates, failures)

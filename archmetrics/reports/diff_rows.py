@@ -1,0 +1,98 @@
+"""The rows every diff format shows, so the table, Markdown and CSV never disagree."""
+
+from __future__ import annotations
+
+from archmetrics.changeset.model import ElementChange, Metrics, Summary
+from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport
+
+# (field, label as in the thesis, equation)
+SUMMARY_ROWS: tuple[tuple[str, str, str], ...] = (
+    ("delta_s_a", "Δs_a", "6.1"),
+    ("delta_s_e", "Δs_e", "6.4"),
+    ("delta_d_a", "Δd_a", "6.7"),
+    ("delta_d_e", "Δd_e", "6.9"),
+    ("loc_pre", "λ_pre", "6.19"),
+    ("loc_post", "λ_post", "6.19"),
+    ("loc_scale", "λ̂", "6.20"),
+    ("added", "Γ_A", "6.16"),
+    ("removed", "Γ_R", "6.17"),
+    ("modified", "Γ_M", "6.18"),
+    ("changes", "Γ", "6.15"),
+    ("scaled_changes", "Γ'", "6.25"),
+    ("vg_pre", "Vg_pre", "6.31"),
+    ("vg_post", "Vg_post", "6.31"),
+    ("vg_scale", "v̂g", "6.33"),
+    ("delta_vg", "ΔVg", "6.30"),
+    ("scaled_delta_vg", "ΔVg'", "6.35"),
+    ("cost", "E", "6.37"),
+)
+
+ELEMENT_HEADER = (
+    "element",
+    "location",
+    "status",
+    "λ pre",
+    "λ post",
+    "v_g pre",
+    "v_g post",
+    "Γ_A",
+    "Γ_R",
+    "Γ_M",
+    "s_a",
+    "s_e",
+    "d_a",
+    "d_e",
+)
+
+
+def number(value: object) -> str:
+    """A summary value as shown: integers plain, ratios to 2 places, undefined as n/a."""
+    if value is None:
+        return "n/a"
+    if isinstance(value, float):
+        return f"{value:.2f}"
+    return str(value)
+
+
+def summary_rows(report: DiffReport) -> list[list[str]]:
+    summaries = report.summaries()
+    return [
+        [label, eq, *(number(getattr(summaries[c], field)) for c in LOCATION_COLUMNS)]
+        for field, label, eq in SUMMARY_ROWS
+    ]
+
+
+def _pair(pre: Metrics | None, post: Metrics | None, field: str) -> str:
+    """``3`` when unchanged, ``2→3`` when it changed, ``-`` for a side that does not exist."""
+    before = number(getattr(pre, field)) if pre else "-"
+    after = number(getattr(post, field)) if post else "-"
+    return after if before == after else f"{before}→{after}"
+
+
+def element_row(e: ElementChange) -> list[str]:
+    def value(m: Metrics | None, field: str) -> str:
+        return number(getattr(m, field)) if m else "-"
+
+    return [
+        e.element,
+        e.location.value,
+        e.status.value,
+        value(e.pre, "loc"),
+        value(e.post, "loc"),
+        value(e.pre, "vg"),
+        value(e.post, "vg"),
+        str(e.added),
+        str(e.removed),
+        str(e.modified),
+        *(_pair(e.pre, e.post, f) for f in ("s_a", "s_e", "d_a", "d_e")),
+    ]
+
+
+def notes(report: DiffReport) -> list[str]:
+    """Every note once, prefixed with the locations it applies to."""
+    where: dict[str, list[str]] = {}
+    summaries: dict[str, Summary] = report.summaries()
+    for column in LOCATION_COLUMNS:
+        for note in summaries[column].notes:
+            where.setdefault(note, []).append(column)
+    return [f"[{', '.join(cols)}] {note}" for note, cols in where.items()]

@@ -1,0 +1,131 @@
+"""FileFacts to and from compact JSON, for the cache. Never pickle: a cache file is not trusted.
+
+The path is left out, so one entry serves every path that holds the same blob; ``decode``
+puts the reader's path back. Anything malformed raises :class:`CodecError`.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from archmetrics.facts import (
+    Argument,
+    CallSite,
+    Class,
+    Decision,
+    Dependency,
+    DependencyKind,
+    FileFacts,
+    Function,
+    ParseWarning,
+    Severity,
+    Span,
+    Statement,
+)
+
+FORMAT = 1
+
+
+class CodecError(ValueError):
+    """A cache entry that is not facts in our format."""
+
+
+def _span(s: Span) -> list[int]:
+    return [s.start, s.end]
+
+
+def encode(facts: FileFacts) -> bytes:
+    document = [
+        FORMAT,
+        facts.language,
+        [[s.kind, *_span(s.span), s.text, s.function] for s in facts.statements],
+        [
+            [
+                f.name,
+                f.qualified_name,
+                *_span(f.span),
+                f.statements,
+                [[d.kind, d.line] for d in f.decisions],
+            ]
+            for f in facts.functions
+        ],
+        [[c.name, c.qualified_name, *_span(c.span), c.kind] for c in facts.classes],
+        [
+            [d.target, str(d.kind), *_span(d.span), d.level, list(d.names)]
+            for d in facts.dependencies
+        ],
+        [
+            [
+                c.callee,
+                c.name,
+                c.receiver,
+                *_span(c.span),
+                c.function,
+                [[a.text, a.value, a.is_literal, a.keyword] for a in c.arguments],
+            ]
+            for c in facts.call_sites
+        ],
+        facts.sloc,
+        [[w.line, w.message, str(w.severity)] for w in facts.warnings],
+        facts.parsed,
+        facts.generated,
+    ]
+    return json.dumps(document, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+
+
+def _decode(document: Any, path: str) -> FileFacts:
+    (
+        fmt,
+        language,
+        statements,
+        functions,
+        classes,
+        deps,
+        calls,
+        sloc,
+        warnings,
+        parsed,
+        generated,
+    ) = document
+    if fmt != FORMAT:
+        raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
+    return FileFacts(
+        path=path,
+        language=language,
+        statements=tuple(Statement(k, Span(a, b), t, fn) for k, a, b, t, fn in statements),
+        functions=tuple(
+            Function(n, q, Span(a, b), tuple(Decision(k, line) for k, line in ds), st)
+            for n, q, a, b, st, ds in functions
+        ),
+        classes=tuple(Class(n, q, Span(a, b), k) for n, q, a, b, k in classes),
+        dependencies=tuple(
+            Dependency(t, DependencyKind(k), Span(a, b), lv, tuple(ns))
+            for t, k, a, b, lv, ns in deps
+        ),
+        call_sites=tuple(
+            CallSite(
+                callee,
+                name,
+                recv,
+                Span(a, b),
+                tuple(Argument(t, v, lit, kw) for t, v, lit, kw in args),
+                fn,
+            )
+            for callee, name, recv, a, b, fn, args in calls
+        ),
+        sloc=sloc,
+        warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
+        parsed=parsed,
+        generated=generated,
+    )
+
+
+def decode(data: bytes, path: str) -> FileFacts:
+    """The facts ``encode`` wrote, now at ``path``; CodecError for anything else."""
+    try:
+        return _decode(json.loads(data), path)
+    except CodecError:
+        raise
+    except (ValueError, TypeError, KeyError) as error:
+        raise CodecError(f"not a facts record: {error}") from error

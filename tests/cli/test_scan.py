@@ -1,0 +1,134 @@
+"""`archmetrics scan` end to end: real trees, real git repositories, the real parsers."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from archmetrics.cli import main
+from tests.gitrepo import GitRepo
+
+PY_V1 = "import os\n\n\ndef f(a):\n    if a:\n        return 1\n    return 2\n"
+PY_V2 = PY_V1 + "\n\ndef g(b):\n    return [x for x in b if x]\n"
+C_SRC = '#include "m.h"\nint m(int a) {\n    return a > 0 && a < 9;\n}\n'
+
+
+def _json(capsys: pytest.CaptureFixture[str], *argv: str) -> dict[str, object]:
+    assert main(list(argv)) == 0
+    out, err = capsys.readouterr()
+    assert err == ""
+    document: dict[str, object] = json.loads(out)
+    return document
+
+
+def _files(document: dict[str, object]) -> dict[str, dict[str, object]]:
+    return {f["path"]: f for f in document["files"]}  # type: ignore[attr-defined, index]
+
+
+def test_sample_is_measured(capsys: pytest.CaptureFixture[str]) -> None:
+    document = _json(capsys, "scan", "--sample", "--format", "json")
+    assert document["schema"] == "archmetrics.scan/1"
+    files = _files(document)
+    assert {"python/odometry.py", "c/motor.c", "c/motor.h"} <= set(files)
+    totals = document["totals"]
+    assert isinstance(totals, dict) and totals["loc"] > 0 and totals["vg"] > 0
+
+
+def test_revision_and_worktree(repo: GitRepo, capsys: pytest.CaptureFixture[str]) -> None:
+    repo.commit("v1", tag="v1", files={"p.py": PY_V1, "m.c": C_SRC})
+    repo.write({"p.py": PY_V2})
+    old = _files(_json(capsys, "scan", str(repo.root), "--rev", "v1", "--format", "json"))
+    new = _files(_json(capsys, "scan", str(repo.root), "--format", "json"))
+    assert old["p.py"]["vg"] == 2 and new["p.py"]["vg"] == 2 + 3
+    assert [f["name"] for f in new["p.py"]["functions"]] == ["f", "g"]  # type: ignore[union-attr]
+    assert old["m.c"] == new["m.c"] and old["m.c"]["vg"] == 2
+
+
+def test_paths_restrict_the_scan(repo: GitRepo, capsys: pytest.CaptureFixture[str]) -> None:
+    repo.commit("v1", files={"a/p.py": PY_V1, "b/q.py": PY_V1})
+    files = _files(_json(capsys, "scan", str(repo.root / "a"), "--format", "json"))
+    assert list(files) == ["a/p.py"]
+
+
+@pytest.mark.parametrize(
+    ("fmt", "needle"),
+    [("table", "p.py"), ("markdown", "| `p.py` |"), ("csv", "path,language,loc,sloc,vg")],
+)
+def test_other_formats(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], fmt: str, needle: str
+) -> None:
+    (tmp_path / "p.py").write_text(PY_V1)
+    assert main(["scan", str(tmp_path), "--format", fmt]) == 0
+    assert needle in capsys.readouterr().out
+
+
+def test_by_function_and_output_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "p.py").write_text(PY_V2)
+    out = tmp_path / "report.csv"
+    assert (
+        main(["scan", str(tmp_path / "src"), "--by", "function", "--format", "csv", "-o", str(out)])
+        == 0
+    )
+    assert capsys.readouterr().out == ""
+    lines = out.read_text().splitlines()
+    assert lines[0] == "path,language,function,line,loc,vg"
+    assert lines[1:] == ["p.py,python,f,4,4,2", "p.py,python,g,10,2,3"]
+
+
+def test_bad_files_never_stop_the_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "ok.py").write_text(PY_V1)
+    (tmp_path / "broken.py").write_text("def f(:\n    pass\n")
+    (tmp_path / "latin.c").write_bytes(b"/* caf\xe9 */\nint x;\n")
+    (tmp_path / "blob.h").write_bytes(b"\x00\x01\x02binary")
+    files = _files(_json(capsys, "scan", str(tmp_path), "--format", "json"))
+    assert files["ok.py"]["parsed"] is True and files["ok.py"]["warnings"] == []
+    assert files["broken.py"]["parsed"] is False and files["broken.py"]["loc"] == 0
+    [warning] = files["broken.py"]["warnings"]  # type: ignore[misc]
+    assert warning["path"] == "broken.py" and warning["line"] == 1
+    assert files["latin.c"]["loc"] == 1 and files["latin.c"]["warnings"][0]["line"] == 1  # type: ignore[index]
+    assert files["blob.h"]["parsed"] is False
+
+
+def test_second_run_is_served_from_the_cache(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "p.py").write_text(PY_V1)
+    cache = tmp_path / "c.sqlite3"
+    first = _json(
+        capsys, "scan", str(tmp_path / "src"), "--format", "json", "--cache-path", str(cache)
+    )
+    second = _json(
+        capsys, "scan", str(tmp_path / "src"), "--format", "json", "--cache-path", str(cache)
+    )
+    assert first == second
+    assert main(["cache", "info", "--cache-path", str(cache)]) == 0
+    assert "entries:     1" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["scan", "--rev", "no-such-rev"], "unknown revision 'no-such-rev'"),
+        (["scan", "/no/such/path"], "no such file or directory"),
+        (["scan", "--format", "yaml"], "invalid choice"),
+        (["scan", "--jobs", "-2"], "--jobs must be 0 or more"),
+    ],
+)
+def test_bad_usage_is_exit_2_with_one_line(repo: GitRepo, argv: list[str], message: str) -> None:
+    repo.commit("v1", files={"p.py": PY_V1})
+    done = subprocess.run(
+        [sys.executable, "-m", "archmetrics", *argv],
+        cwd=repo.root,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2
+    assert message in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr

@@ -1,0 +1,129 @@
+"""The facts cache: round trips, hits by content, and recovery from bad files."""
+
+from __future__ import annotations
+
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from archmetrics.facts import (
+    Argument,
+    CallSite,
+    Class,
+    Decision,
+    Dependency,
+    DependencyKind,
+    FileFacts,
+    Function,
+    ParseWarning,
+    Severity,
+    Span,
+    Statement,
+)
+from archmetrics.sources import codec
+from archmetrics.sources.cache import FactsCache
+from tests.harness import facts_of
+
+SAMPLE = FileFacts(
+    path="a/b.py",
+    language="python",
+    statements=(
+        Statement("assign", Span(1, 2), "x = 1", None),
+        Statement("def", Span(3, 3), "def f ( ) :", "f"),
+    ),
+    functions=(Function("f", "f", Span(3, 5), (Decision("if", 4), Decision("and", 4)), 3),),
+    classes=(Class("C", "C", Span(6, 9), "class"),),
+    dependencies=(Dependency("", DependencyKind.IMPORT, Span(1, 1), 2, ("m", "n")),),
+    call_sites=(
+        CallSite(
+            "bus.request",
+            "request",
+            "bus",
+            Span(4, 4),
+            (
+                Argument("'wdb'", "wdb", True),
+                Argument("x", None, False, "timeout"),
+                Argument("2.5", 2.5, True),
+                Argument("True", True, True),
+            ),
+            "f",
+        ),
+    ),
+    sloc=7,
+    warnings=(ParseWarning("a/b.py", 3, "odd", Severity.ERROR),),
+    parsed=True,
+    generated=True,
+)
+
+
+def test_codec_round_trip() -> None:
+    assert codec.decode(codec.encode(SAMPLE), "a/b.py") == SAMPLE
+
+
+def test_codec_moves_facts_to_the_readers_path() -> None:
+    moved = codec.decode(codec.encode(SAMPLE), "c/d.py")
+    assert moved.path == "c/d.py" and moved.warnings[0].path == "c/d.py"
+
+
+@pytest.mark.parametrize("language", ["python", "c", "cpp"])
+def test_codec_round_trips_real_parser_output(language: str) -> None:
+    source = {
+        "python": "import os\n\ndef f(a):\n    if a and os.sep:\n        return g('x', 1)\n",
+        "c": '#include <stdio.h>\nint f(int a) {\n    if (a && a > 1) return g("x", 1);\n'
+        "    return 0;\n}\n",
+        "cpp": '#include "a.h"\nnamespace n { struct S { int f(int a) { return a ? 1 : 2; } }; }\n',
+    }[language]
+    facts = facts_of(source, language)
+    assert codec.decode(codec.encode(facts), facts.path) == facts
+
+
+@pytest.mark.parametrize("bad", [b"", b"[]", b"{}", b"[2]", b"not json", b'[1, "python"]'])
+def test_codec_rejects_what_it_did_not_write(bad: bytes) -> None:
+    with pytest.raises(codec.CodecError):
+        codec.decode(bad, "x.py")
+
+
+def test_cache_hits_by_blob_and_survives_reopen(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        assert cache.get("abc", "python", "a/b.py") is None
+        cache.put_many([("abc", SAMPLE)])
+    with FactsCache(path) as cache:
+        assert cache.get("abc", "python", "x/y.py") == codec.decode(codec.encode(SAMPLE), "x/y.py")
+        assert cache.get("abc", "c", "a/b.py") is None
+        assert (cache.hits, cache.misses) == (1, 1)
+        assert cache.info().entries == 1
+        assert cache.clear() == 1
+        assert cache.get("abc", "python", "a/b.py") is None
+
+
+def test_corrupt_cache_is_moved_aside_and_rebuilt(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    path.write_bytes(b"this is not a database" * 100)
+    with FactsCache(path) as cache:
+        assert cache.notices and "moved it to" in cache.notices[0]
+        cache.put_many([("abc", SAMPLE)])
+        assert cache.get("abc", "python", "a/b.py") is not None
+    assert len(list(tmp_path.glob("cache.sqlite3.bad-*"))) == 1
+
+
+def test_foreign_database_is_not_trusted_nor_destroyed(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    db = sqlite3.connect(path)
+    db.execute("create table facts(blob, language, parser, data)")
+    db.commit()
+    db.close()
+    with FactsCache(path) as cache:
+        assert "not an archmetrics facts cache" in cache.notices[0]
+    [aside] = tmp_path.glob("cache.sqlite3.bad-*")
+    assert sqlite3.connect(aside).execute("select count(*) from facts").fetchone() == (0,)
+
+
+def test_bad_entry_is_dropped_and_reparsed(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+        cache._db.execute("update facts set data = ?", (b"garbage",))
+        assert cache.get("abc", "python", "a/b.py") is None
+        assert cache.info().entries == 0
