@@ -7,12 +7,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from archmetrics.app.collect import parse_all, select
+from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import Progress
 from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
 from archmetrics.changeset.gates import Gate, check_gates, parse_gate
 from archmetrics.config import Settings
-from archmetrics.app.coupling import coupling_options, rule_set
-from archmetrics.coupling import CouplingOptions, measure_coupling
+from archmetrics.coupling import CouplingOptions, group_elements, measure_coupling
 from archmetrics.coupling.rules import RuleSet
 from archmetrics.facts import FileFacts, ParseWarning
 from archmetrics.parsers import LanguageTable
@@ -113,9 +113,10 @@ def measure_change(
     pre = _parse_side(base, request, progress, cache)
     post = _parse_side(head, request, progress, cache)
     options, packs = coupling_options(request.settings), rule_set(request.settings, root)
+    paths = {f.path for f in (*pre, *post)}
     change = compute_change(
         pair_files(pre, post, git.renames(repo, request.base, request.head)),
-        None,
+        group_elements(paths, options.per_file),
         rules,
         coupling_values(pre, rules, options, packs),
         coupling_values(post, rules, options, packs),

@@ -80,9 +80,8 @@ def run_scan(
         missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
         if missing:
             raise SourceError(f"{missing[0]}: no such path at revision {request.rev}")
-    facts = parse_all(
-        snapshot, selected, overrides, request.jobs or request.settings.jobs, progress
-    )
+    jobs = request.jobs or request.settings.jobs
+    facts = parse_all(snapshot, selected, overrides, jobs, progress, cache)
     metrics = tuple(file_metrics(f) for f in facts)
     return ScanReport(
         root=str(root),

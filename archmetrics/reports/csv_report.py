@@ -4,10 +4,18 @@ from __future__ import annotations
 
 import csv
 import io
+from typing import Any
 
 from archmetrics.changeset.model import SUMMARY_FIELDS
 from archmetrics.reports import coupling_rows
-from archmetrics.reports.model import DiffReport, ScanReport
+from archmetrics.reports.diff_rows import TREND_FIELDS
+from archmetrics.reports.model import (
+    LOCATION_COLUMNS,
+    CompareReport,
+    DiffReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def render_scan(report: ScanReport, grouping: str) -> str:
@@ -79,4 +87,29 @@ def render_diff(report: DiffReport) -> str:
                 "",
             ]
         )
+    return out.getvalue()
+
+
+def _trend(writer: Any, approach: str, series: SeriesReport) -> None:
+    for stage in series.stages:
+        summaries = stage.report.summaries()
+        for location in LOCATION_COLUMNS:
+            summary = summaries[location]
+            values = [getattr(summary, f) for f, _ in TREND_FIELDS]
+            writer.writerow(
+                [approach, stage.label, location, *("" if v is None else v for v in values)]
+            )
+
+
+def render_series(report: SeriesReport) -> str:
+    """A row per stage and location: the trend fields (raw numbers)."""
+    return render_compare(CompareReport((("", report),)))
+
+
+def render_compare(report: CompareReport) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["approach", "stage", "location", *(f for f, _ in TREND_FIELDS)])
+    for name, series in report.series:
+        _trend(writer, name, series)
     return out.getvalue()

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from archmetrics.changeset.model import ElementChange, Metrics, Summary
-from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport
+from archmetrics.reports.model import LOCATION_COLUMNS, CompareReport, DiffReport, SeriesReport
 
 # (field, label as in the thesis, equation)
 SUMMARY_ROWS: tuple[tuple[str, str, str], ...] = (
@@ -96,3 +96,40 @@ def notes(report: DiffReport) -> list[str]:
         for note in summaries[column].notes:
             where.setdefault(note, []).append(column)
     return [f"[{', '.join(cols)}] {note}" for note, cols in where.items()]
+
+
+# The per-location summary across stages: the thesis's per-stage figures in one table.
+TREND_FIELDS: tuple[tuple[str, str], ...] = (
+    ("delta_s_a", "Δs_a"),
+    ("delta_s_e", "Δs_e"),
+    ("delta_d_a", "Δd_a"),
+    ("delta_d_e", "Δd_e"),
+    ("loc_post", "λ_post"),
+    ("changes", "Γ"),
+    ("scaled_changes", "Γ'"),
+    ("delta_vg", "ΔVg"),
+    ("scaled_delta_vg", "ΔVg'"),
+    ("cost", "E"),
+)
+TREND_HEADER = ("approach", "stage", "location", *(label for _, label in TREND_FIELDS))
+
+
+def trend_rows(series: SeriesReport, approach: str = "") -> list[list[str]]:
+    """One row per location (and total) per stage."""
+    rows = []
+    for location in LOCATION_COLUMNS:
+        for stage in series.stages:
+            summary = stage.report.summaries()[location]
+            values = (number(getattr(summary, field)) for field, _ in TREND_FIELDS)
+            rows.append([approach, stage.label, location, *values])
+    return rows
+
+
+def compare_rows(compare: CompareReport) -> list[list[str]]:
+    """Rows of every series, grouped by location, then approach, then stage."""
+    per_series = {name: trend_rows(series, name) for name, series in compare.series}
+    rows: list[list[str]] = []
+    for location in LOCATION_COLUMNS:
+        for series_rows in per_series.values():
+            rows.extend(r for r in series_rows if r[2] == location)
+    return rows

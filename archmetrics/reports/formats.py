@@ -6,7 +6,7 @@ from collections.abc import Callable
 from enum import StrEnum
 
 from archmetrics.reports import csv_report, json_report, markdown_report, table_report
-from archmetrics.reports.model import DiffReport, ScanReport
+from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
 
 
 class OutputFormat(StrEnum):
@@ -51,3 +51,26 @@ assert set(_DIFF) == set(OutputFormat), "every output format needs a diff render
 
 def render_diff(report: DiffReport, fmt: OutputFormat) -> str:
     return _DIFF[fmt](report)
+
+
+_SERIES: dict[OutputFormat, Callable[[SeriesReport], str]] = {
+    OutputFormat.TABLE: table_report.render_series,
+    OutputFormat.JSON: json_report.render_series,
+    OutputFormat.MARKDOWN: markdown_report.render_series,
+    OutputFormat.CSV: csv_report.render_series,
+}
+_COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
+    OutputFormat.TABLE: table_report.render_compare,
+    OutputFormat.JSON: json_report.render_compare,
+    OutputFormat.MARKDOWN: markdown_report.render_compare,
+    OutputFormat.CSV: csv_report.render_compare,
+}
+assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs series/compare"
+
+
+def render_series(report: SeriesReport, fmt: OutputFormat) -> str:
+    return _SERIES[fmt](report)
+
+
+def render_compare(report: CompareReport, fmt: OutputFormat) -> str:
+    return _COMPARE[fmt](report)

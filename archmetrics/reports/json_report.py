@@ -8,7 +8,16 @@ from typing import Any
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
-from archmetrics.reports.model import DIFF_SCHEMA, SCAN_SCHEMA, DiffReport, ScanReport
+from archmetrics.reports.model import (
+    COMPARE_SCHEMA,
+    DIFF_SCHEMA,
+    SCAN_SCHEMA,
+    SERIES_SCHEMA,
+    CompareReport,
+    DiffReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def warning_dict(warning: ParseWarning) -> dict[str, Any]:
@@ -91,3 +100,29 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
 
 def render_diff(report: DiffReport) -> str:
     return dumps(diff_dict(report))
+
+
+def series_dict(report: SeriesReport) -> dict[str, Any]:
+    stages = []
+    for stage in report.stages:
+        document = diff_dict(stage.report)
+        del document["schema"]
+        stages.append({"label": stage.label, **document})
+    return {"schema": SERIES_SCHEMA, "repo": report.repo, "stages": stages}
+
+
+def render_series(report: SeriesReport) -> str:
+    return dumps(series_dict(report))
+
+
+def compare_dict(report: CompareReport) -> dict[str, Any]:
+    series = {}
+    for name, one in report.series:
+        document = series_dict(one)
+        del document["schema"]
+        series[name] = document
+    return {"schema": COMPARE_SCHEMA, "series": series}
+
+
+def render_compare(report: CompareReport) -> str:
+    return dumps(compare_dict(report))

@@ -5,7 +5,13 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from archmetrics.reports import coupling_rows, diff_rows
-from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport, ScanReport
+from archmetrics.reports.model import (
+    LOCATION_COLUMNS,
+    CompareReport,
+    DiffReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def escape(cell: object) -> str:
@@ -82,3 +88,21 @@ def render_diff(report: DiffReport) -> str:
     if bullets:
         parts.append("\n".join(bullets) + "\n")
     return "\n".join(parts)
+
+
+def render_series(report: SeriesReport) -> str:
+    parts = [
+        render_diff(s.report).replace("## archmetrics:", f"## stage {s.label}:", 1)
+        for s in report.stages
+    ]
+    rows = [r[1:] for r in diff_rows.trend_rows(report)]
+    parts.append("## Per location, across stages\n")
+    parts.append(table(list(diff_rows.TREND_HEADER[1:]), rows, "ll" + "r" * 10))
+    return "\n".join(parts)
+
+
+def render_compare(report: CompareReport) -> str:
+    names = ", ".join(f"`{name}`" for name, _ in report.series)
+    return f"## Compared: {names}\n\n" + table(
+        list(diff_rows.TREND_HEADER), diff_rows.compare_rows(report), "lll" + "r" * 10
+    )

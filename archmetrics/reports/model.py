@@ -12,6 +12,8 @@ from archmetrics.facts import FileFacts, ParseWarning
 
 SCAN_SCHEMA = "archmetrics.scan/1"
 DIFF_SCHEMA = "archmetrics.diff/1"
+SERIES_SCHEMA = "archmetrics.series/1"
+COMPARE_SCHEMA = "archmetrics.compare/1"
 LOCATION_COLUMNS = ("base", "new", "framework", "total")
 
 
@@ -79,3 +81,32 @@ class DiffReport:
         found = {loc.value: summary for loc, summary in self.change.locations}
         found["total"] = self.change.total
         return found
+
+
+@dataclass(frozen=True, slots=True)
+class Stage:
+    """One stage of a series: its label and its diff against the stage before."""
+
+    label: str
+    report: DiffReport
+
+
+@dataclass(frozen=True, slots=True)
+class SeriesReport:
+    repo: str
+    stages: tuple[Stage, ...]
+
+    @property
+    def failures(self) -> tuple[GateFailure, ...]:
+        return tuple(f for s in self.stages for f in s.report.failures)
+
+
+@dataclass(frozen=True, slots=True)
+class CompareReport:
+    """Several series side by side, e.g. the thesis's SOA, Player and P2P approaches."""
+
+    series: tuple[tuple[str, SeriesReport], ...]
+
+    @property
+    def failures(self) -> tuple[GateFailure, ...]:
+        return tuple(f for _, s in self.series for f in s.failures)

@@ -9,7 +9,13 @@ from rich.console import Console
 from rich.table import Table
 
 from archmetrics.reports import coupling_rows, diff_rows
-from archmetrics.reports.model import LOCATION_COLUMNS, DiffReport, ScanReport
+from archmetrics.reports.model import (
+    LOCATION_COLUMNS,
+    CompareReport,
+    DiffReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
@@ -105,3 +111,19 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines += [f"warning {w}" for w in report.warnings]
     lines += [str(f) for f in report.failures]
     return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
+
+
+def render_series(report: SeriesReport, color: bool = False) -> str:
+    """One diff per stage, then the per-location summary across stages."""
+    parts = [f"== stage {s.label} ==\n" + render_diff(s.report, color) for s in report.stages]
+    rows = diff_rows.trend_rows(report)
+    header = diff_rows.TREND_HEADER[1:]
+    trend = rows_table("per location, across stages", header, [r[1:] for r in rows], 2)
+    return "\n".join(parts) + "\n" + to_text(trend, color=color)
+
+
+def render_compare(report: CompareReport, color: bool = False) -> str:
+    rows = diff_rows.compare_rows(report)
+    names = ", ".join(name for name, _ in report.series)
+    table = rows_table(f"compared: {names}", diff_rows.TREND_HEADER, rows, 3)
+    return to_text(table, color=color)

@@ -151,3 +151,14 @@ def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:
         if status.startswith("R"):
             pairs[old] = new
     return pairs
+
+
+def tags_in_order(path: Path) -> tuple[str, ...]:
+    """The repository's tags in history order (by how many commits lie behind each, then by
+    name): the stages of a study subject, oldest first."""
+    repo = open_repository(path)
+    names = [str(tag) for tag in repo.tags]
+    if not names:
+        raise SourceError(f"{path}: no tags to take stages from; give --revisions")
+    depth = {name: int(repo.git.rev_list("--count", f"{name}^{{commit}}")) for name in names}
+    return tuple(sorted(names, key=lambda name: (depth[name], name)))

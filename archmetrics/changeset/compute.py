@@ -1,0 +1,153 @@
+"""One base..new comparison: file pairs in, a :class:`ChangeReport` out (pure, no I/O).
+
+``compute_change(pairs, elements, rules, coupling_pre, coupling_post)``
+
+* ``pairs``: every measured file of either revision as a :class:`FilePair` (pre facts or None,
+  post facts or None); the caller pairs files across revisions, following git renames.
+* ``elements``: the element grouping (``archmetrics.coupling.elements.group_elements`` over the
+  union of both revisions' paths, or any objects with ``name`` and ``files``); None groups the
+  paths with ``group_elements``. Files no element lists are elements of their own.
+* ``rules``: :class:`LocationRules` -- locations by path glob, exclusions.
+* ``coupling_pre`` / ``coupling_post``: element name -> :class:`Coupling` (s_a, s_e, d_a, d_e)
+  measured on each tree by the coupling layer (:func:`coupling_by_element` converts a
+  ``CouplingReport``); None when coupling was not measured (zeros, flagged in the notes).
+* ``dynamic_pre_zero``: apply the thesis convention (p. 100) that d_a and d_e are 0 before the
+  integration, instead of the values measured on the pre tree (the default).
+
+Excluded files count nowhere and are listed with their reason: a side whose path matches an
+exclude glob or whose facts say ``generated`` is dropped alone; a pair with a side no parser
+could read is dropped whole. Every location appears in the report, empty
+or not; sums run over all elements of a location, changed or not (docs/_drafts/changeset.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+from archmetrics.changeset.cost import Sums, location_summary, total_summary
+from archmetrics.changeset.elements import ElementLike, Side, assign, element_change, element_index
+from archmetrics.changeset.locations import Location, LocationRules
+from archmetrics.changeset.model import (
+    ChangeReport,
+    Coupling,
+    ElementChange,
+    ExcludedFile,
+    FilePair,
+    Metrics,
+)
+from archmetrics.coupling.elements import group_elements
+from archmetrics.coupling.model import CouplingReport
+from archmetrics.facts import FileFacts
+
+
+def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
+    """The coupling layer's per-element results as the mapping :func:`compute_change` takes."""
+    return {e.element.name: Coupling(e.s_a, e.s_e, e.d_a, e.d_e) for e in report.elements}
+
+
+def _side_exclusion(facts: FileFacts | None, rules: LocationRules) -> str | None:
+    """Why one side of a pair is left out (its path's exclude glob, or generated), or None."""
+    if facts is None:
+        return None
+    if reason := rules.is_excluded(facts.path):
+        return reason
+    return "generated" if rules.exclude_generated and facts.generated else None
+
+
+def _filter(pair: FilePair, rules: LocationRules) -> tuple[FilePair | None, list[ExcludedFile]]:
+    """The measured part of a pair and what was left out of it.
+
+    A side that could not be parsed drops the whole pair (diffing it would show every
+    statement as added or removed). An excluded side alone drops only that side: a file that
+    leaves ``generated/`` for hand-written code is an addition.
+    """
+    sides = [f for f in (pair.pre, pair.post) if f is not None]
+    if any(not f.parsed for f in sides):
+        return None, [ExcludedFile(pair.path, "not_parsed")]
+    reasons = (_side_exclusion(pair.pre, rules), _side_exclusion(pair.post, rules))
+    excluded = {
+        ExcludedFile(f.path, r)
+        for f, r in zip((pair.pre, pair.post), reasons, strict=True)
+        if f and r
+    }
+    pre = None if reasons[0] else pair.pre
+    post = None if reasons[1] else pair.post
+    kept = FilePair(pre, post) if pre or post else None
+    return kept, sorted(excluded, key=lambda x: (x.path, x.reason))
+
+
+def _partition(
+    pairs: Iterable[FilePair], rules: LocationRules
+) -> tuple[list[FilePair], list[ExcludedFile]]:
+    kept: list[FilePair] = []
+    excluded: list[ExcludedFile] = []
+    for pair in pairs:
+        measured, left_out = _filter(pair, rules)
+        kept += [measured] if measured else []
+        excluded += left_out
+    return kept, sorted(excluded, key=lambda x: (x.path, x.reason))
+
+
+def _sums(elements: Iterable[ElementChange]) -> Sums:
+    """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31)."""
+    pre, post, added, removed, modified = Metrics(), Metrics(), 0, 0, 0
+    for element in elements:
+        pre = pre + (element.pre or Metrics())
+        post = post + (element.post or Metrics())
+        added, removed, modified = (
+            added + element.added,
+            removed + element.removed,
+            modified + element.modified,
+        )
+    return Sums(pre, post, added, removed, modified)
+
+
+def _side_notes(sides: tuple[Side, Side]) -> list[str]:
+    notes: list[str] = []
+    for side in sides:
+        if side.values is None:
+            notes.append(
+                f"coupling_not_measured_{side.label}: no {side.label} coupling values were given;"
+                " s_a, s_e, d_a, d_e taken as 0"
+            )
+    if sides[0].dynamic_zero:
+        notes.append("dynamic_pre_zero: d_a, d_e before integration taken as 0 (thesis p. 100)")
+    return notes
+
+
+def compute_change(
+    pairs: Iterable[FilePair],
+    elements: Iterable[ElementLike] | None,
+    rules: LocationRules,
+    coupling_pre: Mapping[str, Coupling] | None,
+    coupling_post: Mapping[str, Coupling] | None,
+    *,
+    dynamic_pre_zero: bool = False,
+) -> ChangeReport:
+    """Chapter 6 metrics of one comparison: per location, total, per element, exclusions."""
+    kept, excluded = _partition(pairs, rules)
+    if elements is None:
+        paths = {f.path for p in kept for f in (p.pre, p.post) if f is not None}
+        elements = group_elements(paths)
+    groups = assign(kept, element_index(elements))
+    sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
+    changes: list[ElementChange] = []
+    notes: dict[Location, list[str]] = {loc: [] for loc in Location}
+    for name in sorted(groups):
+        element_notes: list[str] = []
+        change = element_change(name, groups[name], rules, sides, element_notes)
+        changes.append(change)
+        notes[change.location] += element_notes
+    common = _side_notes(sides)
+    summaries = tuple(
+        (
+            loc,
+            location_summary(
+                _sums(c for c in changes if c.location is loc), (*common, *notes[loc])
+            ),
+        )
+        for loc in Location
+    )
+    all_notes = [*common, *(n for loc in Location for n in notes[loc])]
+    total = total_summary((s for _, s in summaries), all_notes)
+    return ChangeReport(summaries, total, tuple(changes), tuple(excluded))

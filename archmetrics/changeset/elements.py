@@ -1,0 +1,146 @@
+"""Element change sets (thesis p. 73): an element's file changes, status and pre/post metrics M.
+
+Files are grouped into elements by name (the coupling layer's ``group_elements`` naming); a
+file pair whose pre and post paths belong to different elements is split into a removal from
+the old element and an addition to the new one, so each element's before/after stays whole.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from archmetrics.changeset.locations import Location, LocationRules
+from archmetrics.changeset.model import Coupling, ElementChange, FilePair, Metrics, Status
+from archmetrics.changeset.statement_diff import diff_files
+from archmetrics.facts import FileFacts
+
+
+class ElementLike(Protocol):
+    """What an element grouping provides (``archmetrics.coupling.elements.Element`` fits)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def files(self) -> tuple[str, ...]: ...
+
+
+@dataclass(frozen=True, slots=True)
+class Side:
+    """One revision's coupling values; ``values`` None means coupling was not measured."""
+
+    label: str  # "pre" or "post"
+    values: Mapping[str, Coupling] | None
+    dynamic_zero: bool = False  # the thesis convention (p. 100): d_a = d_e = 0 before
+
+
+def element_index(elements: Iterable[ElementLike]) -> dict[str, str]:
+    """path -> element name; the same name twice is merged, a path in two names is an error."""
+    index: dict[str, str] = {}
+    for element in elements:
+        for path in element.files:
+            owner = index.setdefault(path, element.name)
+            if owner != element.name:
+                raise ValueError(f"{path!r} is in two elements: {owner!r} and {element.name!r}")
+    return index
+
+
+def assign(pairs: Iterable[FilePair], index: Mapping[str, str]) -> dict[str, list[FilePair]]:
+    """Pairs per element name; unlisted files are their own element, named by their path."""
+    groups: dict[str, list[FilePair]] = {}
+    for pair in pairs:
+        pre_owner = index.get(pair.pre.path, pair.pre.path) if pair.pre else None
+        post_owner = index.get(pair.post.path, pair.post.path) if pair.post else None
+        owner = post_owner or pre_owner  # a renamed file follows itself into its new element
+        assert owner is not None
+        groups.setdefault(owner, []).append(pair)
+    return groups
+
+
+def _metrics(
+    element: str, files: Sequence[FileFacts], side: Side, notes: list[str]
+) -> Metrics | None:
+    """M of one side: λ, SLOC, v_g summed over the files, coupling from the coupling layer."""
+    if not files:
+        return None
+    coupling = Coupling()
+    if side.values is not None:
+        found = side.values.get(element)
+        if found is None:
+            notes.append(
+                f"coupling_missing_{side.label}: element {element!r} has no {side.label}"
+                " coupling values; taken as 0"
+            )
+        coupling = found or coupling
+    if side.dynamic_zero:
+        coupling = coupling._replace(d_a=0, d_e=0)
+    return Metrics(
+        loc=sum(f.loc for f in files),
+        sloc=sum(f.sloc for f in files),
+        vg=sum(f.vg for f in files),
+        s_a=coupling.s_a,
+        s_e=coupling.s_e,
+        d_a=coupling.d_a,
+        d_e=coupling.d_e,
+    )
+
+
+def _location(
+    element: str, pairs: Sequence[FilePair], rules: LocationRules, notes: list[str]
+) -> Location:
+    """Where most of the element's files are (ties: its first file's); mixed ones are flagged."""
+    by_file = [rules.location_of(p.path) for p in sorted(pairs, key=lambda p: p.path)]
+    counts = Counter(by_file)
+    location = max(counts, key=lambda loc: (counts[loc], -by_file.index(loc)))
+    if len(counts) > 1:
+        spread = ", ".join(sorted(loc.value for loc in counts))
+        notes.append(
+            f"element_mixed_locations: element {element!r} has files in {spread};"
+            f" counted in {location.value}"
+        )
+    return location
+
+
+def _status(pre: Metrics | None, post: Metrics | None, changes: int) -> Status:
+    if pre is None:
+        return Status.ADDED
+    if post is None:
+        return Status.REMOVED
+    return Status.MODIFIED if changes else Status.UNCHANGED
+
+
+def element_change(
+    element: str,
+    pairs: Sequence[FilePair],
+    rules: LocationRules,
+    sides: tuple[Side, Side],
+    notes: list[str],
+) -> ElementChange:
+    """The change set of one element: statement diffs of its files, status, M before and after."""
+    file_changes = tuple(diff_files(p.pre, p.post) for p in sorted(pairs, key=lambda p: p.path))
+    for change in file_changes:
+        if change.approximate:
+            notes.append(
+                f"pairing_approximate: {change.post_path or change.pre_path!r} has a replace run"
+                " too large for exact pairing; modified statements were paired greedily"
+            )
+    pre = _metrics(element, [p.pre for p in pairs if p.pre], sides[0], notes)
+    post = _metrics(element, [p.post for p in pairs if p.post], sides[1], notes)
+    added = sum(c.added for c in file_changes)
+    removed = sum(c.removed for c in file_changes)
+    modified = sum(c.modified for c in file_changes)
+    return ElementChange(
+        element=element,
+        location=_location(element, pairs, rules, notes),
+        files=tuple(sorted(p.path for p in pairs)),
+        status=_status(pre, post, added + removed + modified),
+        pre=pre,
+        post=post,
+        added=added,
+        removed=removed,
+        modified=modified,
+        file_changes=file_changes,
+    )

@@ -1,0 +1,197 @@
+"""The frozen values a change computation returns, and their JSON shape (a public contract).
+
+Field names are the JSON keys: a :class:`Summary` is one location's (or the total's) metrics
+S, an :class:`ElementChange` one element's change set with its pre/post metrics M. ``to_dict``
+gives plain JSON types: ints, floats, strings, lists, and None (``null``) where a value is
+undefined -- always with a note saying why (docs/_drafts/changeset.md, "Conventions").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import NamedTuple
+
+from archmetrics.changeset.locations import Location
+from archmetrics.changeset.statement_diff import FileChange
+from archmetrics.facts import FileFacts
+
+JsonValue = int | float | str | None | list["JsonValue"] | dict[str, "JsonValue"]
+
+
+class Coupling(NamedTuple):
+    """One element's coupling in one revision, from the coupling layer: s_a, s_e, d_a, d_e."""
+
+    s_a: int = 0
+    s_e: int = 0
+    d_a: int = 0
+    d_e: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Metrics:
+    """M: an element's (or a location's summed) size, complexity and coupling in one revision."""
+
+    loc: int = 0  # λ, logical lines of code (thesis p. 103)
+    sloc: int = 0  # physical non-blank, non-comment lines (informative; not in any equation)
+    vg: int = 0  # McCabe v_g, summed over functions (eq. 6.31)
+    s_a: int = 0
+    s_e: int = 0
+    d_a: int = 0
+    d_e: int = 0
+
+    def __add__(self, other: Metrics) -> Metrics:
+        return Metrics(*(a + b for a, b in zip(self.as_tuple(), other.as_tuple(), strict=True)))
+
+    def as_tuple(self) -> tuple[int, int, int, int, int, int, int]:
+        return (self.loc, self.sloc, self.vg, self.s_a, self.s_e, self.d_a, self.d_e)
+
+    def to_dict(self) -> dict[str, JsonValue]:
+        return dict(
+            zip(("loc", "sloc", "vg", "s_a", "s_e", "d_a", "d_e"), self.as_tuple(), strict=True)
+        )
+
+
+class Status(StrEnum):
+    """What happened to an element's change set."""
+
+    ADDED = "added"  # no file of it existed before
+    REMOVED = "removed"  # no file of it exists after
+    MODIFIED = "modified"  # it existed on both sides and Γ > 0
+    UNCHANGED = "unchanged"  # it existed on both sides and Γ = 0
+
+
+@dataclass(frozen=True, slots=True)
+class FilePair:
+    """One file across the two revisions (the caller pairs them, following git renames)."""
+
+    pre: FileFacts | None
+    post: FileFacts | None
+
+    def __post_init__(self) -> None:
+        if self.pre is None and self.post is None:
+            raise ValueError("a file pair needs at least one side")
+
+    @property
+    def path(self) -> str:
+        """The post path, or the pre path of a removed file."""
+        side = self.post or self.pre
+        assert side is not None
+        return side.path
+
+
+@dataclass(frozen=True, slots=True)
+class ElementChange:
+    """An element's change set: its files' statement changes and its metrics before and after."""
+
+    element: str
+    location: Location
+    files: tuple[str, ...]  # post paths (pre path for removed files), sorted
+    status: Status
+    pre: Metrics | None  # None: the element did not exist before
+    post: Metrics | None  # None: the element no longer exists
+    added: int
+    removed: int
+    modified: int
+    file_changes: tuple[FileChange, ...] = ()  # the detail behind added/removed/modified
+
+    def to_dict(self) -> dict[str, JsonValue]:
+        return {
+            "element": self.element,
+            "location": self.location.value,
+            "files": list(self.files),
+            "status": self.status.value,
+            "pre": self.pre.to_dict() if self.pre else None,
+            "post": self.post.to_dict() if self.post else None,
+            "added": self.added,
+            "removed": self.removed,
+            "modified": self.modified,
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class Summary:
+    """S: the chapter-6 metrics of one location or of the total (equation numbers in cost.py)."""
+
+    delta_s_a: int
+    delta_s_e: int
+    delta_d_a: int
+    delta_d_e: int
+    loc_pre: int
+    loc_post: int
+    loc_scale: float | None  # None: λ_pre = 0, see notes
+    added: int
+    removed: int
+    modified: int
+    changes: int
+    scaled_changes: float
+    vg_pre: int
+    vg_post: int
+    vg_scale: float | None  # None: Vg_pre = 0, see notes
+    delta_vg: int
+    scaled_delta_vg: float
+    cost: float
+    notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, JsonValue]:
+        out: dict[str, JsonValue] = {}
+        for name in SUMMARY_FIELDS:
+            value = getattr(self, name)
+            out[name] = list(value) if isinstance(value, tuple) else value
+        return out
+
+
+SUMMARY_FIELDS: tuple[str, ...] = (
+    "delta_s_a",
+    "delta_s_e",
+    "delta_d_a",
+    "delta_d_e",
+    "loc_pre",
+    "loc_post",
+    "loc_scale",
+    "added",
+    "removed",
+    "modified",
+    "changes",
+    "scaled_changes",
+    "vg_pre",
+    "vg_post",
+    "vg_scale",
+    "delta_vg",
+    "scaled_delta_vg",
+    "cost",
+    "notes",
+)
+
+
+@dataclass(frozen=True, slots=True)
+class ExcludedFile:
+    """A file left out of every number, and why (``exclude:<glob>``, ``generated``, ...)."""
+
+    path: str
+    reason: str
+
+    def to_dict(self) -> dict[str, JsonValue]:
+        return {"path": self.path, "reason": self.reason}
+
+
+@dataclass(frozen=True, slots=True)
+class ChangeReport:
+    """Everything one base..new comparison measured: per location, total, elements, exclusions."""
+
+    locations: tuple[tuple[Location, Summary], ...]  # always base, new, framework, in that order
+    total: Summary
+    elements: tuple[ElementChange, ...]
+    excluded: tuple[ExcludedFile, ...]
+
+    def location(self, location: Location) -> Summary:
+        """The summary S(L) of one location."""
+        return dict(self.locations)[location]
+
+    def to_dict(self) -> dict[str, JsonValue]:
+        return {
+            "locations": {loc.value: summary.to_dict() for loc, summary in self.locations},
+            "total": self.total.to_dict(),
+            "elements": [e.to_dict() for e in self.elements],
+            "excluded": [x.to_dict() for x in self.excluded],
+        }

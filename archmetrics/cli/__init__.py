@@ -1,0 +1,58 @@
+"""The ``archmetrics`` command line: flags become a request, one use case runs, a report prints.
+
+Exit status: 0 measured (and every gate holds), 1 a gate failed, 2 could not measure (bad usage,
+unknown revision, bad configuration) with a one-line error and no traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+from archmetrics.app.series import SeriesError
+from archmetrics.changeset.gates import GateError
+from archmetrics.changeset.locations import BadPattern
+from archmetrics.cli import measure, study
+from archmetrics.cli.common import EXIT_USAGE, UsageError
+from archmetrics.cli.parser import build_parser
+from archmetrics.config import ConfigError
+from archmetrics.coupling.rules import RulePackError
+from archmetrics.parsers import UnknownLanguage
+from archmetrics.sources import SourceError
+from archmetrics.study.manifest import ManifestError
+
+COMMANDS = {
+    "scan": measure.scan_command,
+    "diff": measure.diff_command,
+    "series": measure.series_command,
+    "compare": measure.compare_command,
+    "replicate": study.replicate_command,
+    "rules": measure.rules_command,
+    "graph": measure.graph_command,
+    "cache": measure.cache_command,
+}
+CANNOT_MEASURE = (
+    SourceError,
+    ConfigError,
+    UnknownLanguage,
+    UsageError,
+    BadPattern,
+    GateError,
+    RulePackError,
+    SeriesError,
+    ManifestError,
+)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        if getattr(args, "jobs", 0) < 0:
+            raise UsageError("--jobs must be 0 or more")
+        return COMMANDS[args.command](args)
+    except CANNOT_MEASURE as error:
+        print(f"archmetrics: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("archmetrics: interrupted", file=sys.stderr)
+        return 130

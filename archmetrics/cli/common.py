@@ -1,0 +1,118 @@
+"""What every command shares: errors, progress, settings, the cache, output."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import NoReturn
+
+from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.changeset.gates import GateFailure
+from archmetrics.config import Settings, load_settings
+from archmetrics.reports.formats import OutputFormat
+from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.cache import default_path as cache_default_path
+
+EXIT_OK, EXIT_GATE, EXIT_USAGE = 0, 1, 2
+
+
+class UsageError(Exception):
+    """Bad usage found after parsing (a missing file, a bad value)."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
+
+
+class RichProgress:
+    """A rich progress bar on stderr, for runs over many files in a terminal."""
+
+    def __init__(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+        self._bar = Progress(
+            "[progress.description]{task.description}",
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeRemainingColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        )
+        self._task: object = None
+
+    def start(self, description: str, total: int) -> None:
+        if total >= 20:
+            self._bar.start()
+            self._task = self._bar.add_task(description, total=total)
+
+    def advance(self, count: int = 1) -> None:
+        if self._task is not None:
+            self._bar.advance(self._task, count)  # type: ignore[arg-type]
+
+    def stop(self) -> None:
+        if self._task is not None:
+            self._bar.stop()
+            self._task = None
+
+
+def progress_for(fmt: OutputFormat, quiet: bool) -> Progress:
+    if quiet or fmt is not OutputFormat.TABLE or not sys.stderr.isatty():
+        return NoProgress()
+    return RichProgress()
+
+
+def sample_path() -> Path:
+    """The small sample tree shipped inside the package (the default main job's input)."""
+    return Path(__file__).resolve().parent.parent / "data" / "sample"
+
+
+def repo_root(path: Path) -> Path:
+    """The top of the git repository holding ``path``, or its folder outside git."""
+    from archmetrics.sources import git
+
+    folder = path if path.is_dir() else path.parent
+    if git.is_repository(folder):
+        return git.toplevel(git.open_repository(folder))
+    return folder
+
+
+def settings_for(path: Path) -> Settings:
+    return load_settings(repo_root(path))
+
+
+def emit(text: str, output: Path | None) -> None:
+    if output is None:
+        sys.stdout.write(text)
+        return
+    try:
+        output.write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise UsageError(f"{output}: cannot write: {error.strerror}") from error
+
+
+@contextmanager
+def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsCache | None]:
+    """The cache the flags and settings ask for (none with --no-cache or cache = false)."""
+    if getattr(args, "no_cache", False) or not settings.cache:
+        yield None
+        return
+    path = args.cache_path or (Path(settings.cache_path) if settings.cache_path else None)
+    with FactsCache(path or cache_default_path()) as cache:
+        for notice in cache.notices:
+            print(f"archmetrics: warning: {notice}", file=sys.stderr)
+        yield cache
+
+
+def gate_status(failures: Sequence[GateFailure]) -> int:
+    for failure in failures:
+        print(f"archmetrics: {failure}", file=sys.stderr)
+    return EXIT_GATE if failures else EXIT_OK
+
+
+def split(text: str | None) -> tuple[str, ...]:
+    return tuple(part.strip() for part in text.split(",") if part.strip()) if text else ()

@@ -1,0 +1,154 @@
+"""The measuring commands: scan, diff, series, compare, graph, rules, cache."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.progress import NoProgress
+from archmetrics.app.scan import ScanRequest, run_scan
+from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
+from archmetrics.cli.common import (
+    EXIT_OK,
+    UsageError,
+    emit,
+    facts_cache,
+    gate_status,
+    progress_for,
+    repo_root,
+    sample_path,
+    settings_for,
+    split,
+)
+from archmetrics.reports.formats import (
+    Grouping,
+    OutputFormat,
+    render_compare,
+    render_diff,
+    render_scan,
+    render_series,
+)
+from archmetrics.sources.git import tags_in_order
+
+
+def cache_command(args: argparse.Namespace) -> int:
+    settings = settings_for(Path.cwd())
+    with facts_cache(args, settings) as cache:
+        assert cache is not None
+        if args.action == "clear":
+            print(f"removed {cache.clear()} entries from {cache.path}")
+            return EXIT_OK
+        info = cache.info()
+        print(f"path:        {info.path}")
+        print(f"entries:     {info.entries} ({info.current_entries} from this parser version)")
+        print(f"size:        {info.bytes / 1e6:.1f} MB")
+        print(f"fingerprint: {info.fingerprint}")
+    return EXIT_OK
+
+
+def scan_command(args: argparse.Namespace) -> int:
+    paths: tuple[Path, ...] = tuple(args.paths)
+    if args.sample:
+        if paths or args.rev:
+            raise UsageError("--sample takes no PATH and no --rev")
+        paths = (sample_path(),)
+    settings = settings_for(paths[0] if paths else Path.cwd())
+    fmt = OutputFormat(args.format)
+    request = ScanRequest(
+        paths=paths, rev=args.rev, settings=settings, jobs=args.jobs, plain_directory=args.sample
+    )
+    with facts_cache(args, settings) as cache:
+        report = run_scan(request, progress_for(fmt, args.quiet), cache)
+    emit(render_scan(report, fmt, Grouping(args.by)), args.output)
+    return EXIT_OK
+
+
+def rules_command(args: argparse.Namespace) -> int:
+    from archmetrics.app.coupling import rule_set
+    from archmetrics.coupling.ruletable import rule_rows, rules_markdown
+    from archmetrics.reports.json_report import dumps
+    from archmetrics.reports.table_report import rows_table, to_text
+
+    settings = settings_for(args.repo)
+    ruleset = rule_set(settings, repo_root(args.repo))
+    if args.format == "markdown":
+        sys.stdout.write(rules_markdown(ruleset))
+        return EXIT_OK
+    rows = rule_rows(ruleset)
+    fields = ("pack", "rule", "language", "match", "kind", "role", "endpoint", "requires")
+    if args.format == "json":
+        document = {
+            "schema": "archmetrics.rules/1",
+            "rules": [{f: getattr(r, f) for f in fields} for r in rows],
+        }
+        sys.stdout.write(dumps(document))
+        return EXIT_OK
+    cells = [[getattr(r, f) for f in fields] for r in rows]
+    sys.stdout.write(to_text(rows_table(f"{len(rows)} rules in force", fields, cells, 8)))
+    return EXIT_OK
+
+
+def graph_command(args: argparse.Namespace) -> int:
+    from archmetrics.reports.graph import render
+
+    paths: tuple[Path, ...] = tuple(args.paths)
+    settings = settings_for(paths[0] if paths else Path.cwd())
+    request = ScanRequest(paths=paths, rev=args.rev, settings=settings, jobs=args.jobs)
+    with facts_cache(args, settings) as cache:
+        report = run_scan(request, NoProgress(), cache)
+    assert report.coupling is not None
+    emit(render(report.coupling.graph, args.format), args.output)
+    return EXIT_OK
+
+
+def diff_request(
+    args: argparse.Namespace, repo: Path, base: str = "", head: str = ""
+) -> DiffRequest:
+    return DiffRequest(
+        root=repo,
+        base=base,
+        head=head,
+        settings=settings_for(repo),
+        new=tuple(args.new),
+        framework=tuple(args.framework),
+        gates=tuple(args.fail_on),
+        jobs=args.jobs,
+        dynamic_pre_zero=args.dynamic_pre_zero,
+    )
+
+
+def series_command(args: argparse.Namespace) -> int:
+    fmt = OutputFormat(args.format)
+    request = SeriesRequest(
+        diff_request(args, args.repo), tuple(args.revisions), split(args.labels), args.root
+    )
+    with facts_cache(args, request.diff.settings) as cache:
+        report = run_series(request, progress_for(fmt, args.quiet), cache)
+    emit(render_series(report, fmt), args.output)
+    return gate_status(report.failures)
+
+
+def compare_command(args: argparse.Namespace) -> int:
+    fmt = OutputFormat(args.format)
+    named = []
+    for text in args.repos:
+        name, path = parse_named_path(text)
+        revisions = split(args.revisions) or tags_in_order(path)
+        request = SeriesRequest(diff_request(args, path), revisions, split(args.labels), args.root)
+        named.append((name, request))
+    with facts_cache(args, named[0][1].diff.settings) as cache:
+        report = run_compare(named, progress_for(fmt, args.quiet), cache)
+    emit(render_compare(report, fmt), args.output)
+    return gate_status(report.failures)
+
+
+def diff_command(args: argparse.Namespace) -> int:
+    fmt = OutputFormat(args.format)
+    request = diff_request(args, args.repo, args.base, args.head)
+    settings = request.settings
+    with facts_cache(args, settings) as cache:
+        report = run_diff(request, progress_for(fmt, args.quiet), cache)
+    emit(render_diff(report, fmt), args.output)
+    return gate_status(report.failures)

@@ -1,0 +1,118 @@
+"""The argument parser: every command, option and default, in one place."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+
+from archmetrics import __version__
+from archmetrics.cli.common import Parser
+from archmetrics.reports.formats import Grouping, OutputFormat
+
+
+def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
+    parser.add_argument("--format", choices=formats, default=formats[0], help="output format")
+    parser.add_argument("--output", "-o", type=Path, help="write the report to FILE")
+    parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
+    parser.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
+    parser.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+
+
+def add_locations(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--new", action="append", default=[], metavar="GLOB", help="new location")
+    parser.add_argument(
+        "--framework", action="append", default=[], metavar="GLOB", help="framework location"
+    )
+    parser.add_argument(
+        "--fail-on",
+        action="append",
+        default=[],
+        metavar="EXPR",
+        help="a gate, e.g. 'cost(new) > 20'; exit 1 when it fails (repeatable)",
+    )
+    parser.add_argument(
+        "--dynamic-pre-zero",
+        action="store_true",
+        help="take d_a, d_e before integration as 0 (the thesis's convention, p. 100)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = Parser(prog="archmetrics", description=__doc__.split("\n")[0])
+    parser.add_argument("--version", action="version", version=f"archmetrics {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    scan = commands.add_parser("scan", help="λ, SLOC and v_g per file and function")
+    scan.add_argument("paths", nargs="*", type=Path, metavar="PATH", help="files or folders")
+    scan.add_argument("--rev", help="measure this git revision instead of the files on disk")
+    scan.add_argument("--by", choices=[g.value for g in Grouping], default="file")
+    scan.add_argument(
+        "--sample", action="store_true", help="scan the sample shipped with archmetrics"
+    )
+    add_output(scan, [f.value for f in OutputFormat])
+    diff = commands.add_parser(
+        "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
+    )
+    diff.add_argument("--base", default="HEAD", help="REV, EMPTY, WORKTREE or INDEX (default HEAD)")
+    diff.add_argument(
+        "--head", default="WORKTREE", help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
+    )
+    diff.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    add_locations(diff)
+    add_output(diff, [f.value for f in OutputFormat])
+    series = commands.add_parser(
+        "series", help="each stage measured against the one before (baseline, first, second)"
+    )
+    series.add_argument("revisions", nargs="+", metavar="REV", help="the stages, oldest first")
+    series.add_argument("--labels", help="comma-separated stage names, e.g. baseline,first,second")
+    series.add_argument("--root", default="EMPTY", help="what the first stage is measured against")
+    series.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    add_locations(series)
+    add_output(series, [f.value for f in OutputFormat])
+    compare = commands.add_parser(
+        "compare", help="the same series for several repositories side by side"
+    )
+    compare.add_argument("repos", nargs="+", metavar="NAME=PATH", help="e.g. soa=./wdb-soa")
+    compare.add_argument(
+        "--revisions",
+        help="comma-separated stage revisions (default: each repo's tags, oldest first)",
+    )
+    compare.add_argument("--labels", help="comma-separated stage names")
+    compare.add_argument("--root", default="EMPTY", help="what the first stage is measured against")
+    add_locations(compare)
+    add_output(compare, [f.value for f in OutputFormat])
+    replicate = commands.add_parser(
+        "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
+    )
+    replicate.add_argument(
+        "--out", type=Path, default=Path("archmetrics-study"), help="where to write the report"
+    )
+    replicate.add_argument(
+        "--subject", action="append", default=[], help="only this subject (wdb, pragmatics, legacy)"
+    )
+    replicate.add_argument(
+        "--keep-repos", type=Path, metavar="DIR", help="build the subjects' repositories here"
+    )
+    replicate.add_argument("--no-charts", action="store_true", help="skip the charts")
+    replicate.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    replicate.add_argument("--jobs", "-j", type=int, default=0, help="parser processes")
+    replicate.add_argument(
+        "--no-cache", action="store_true", help="parse everything, store nothing"
+    )
+    replicate.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    rules = commands.add_parser("rules", help="the dynamic-coupling rules in force")
+    rules.add_argument("--format", choices=["table", "markdown", "json"], default="table")
+    rules.add_argument("--repo", "-C", type=Path, default=Path("."), help="whose config to read")
+    graph = commands.add_parser("graph", help="the element graph: who depends on and talks to whom")
+    graph.add_argument("paths", nargs="*", type=Path, metavar="PATH", help="files or folders")
+    graph.add_argument("--rev", help="the git revision to draw instead of the files on disk")
+    graph.add_argument("--format", choices=["dot", "mermaid", "json"], default="dot")
+    graph.add_argument("--output", "-o", type=Path, help="write the graph to FILE")
+    graph.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
+    graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
+    graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    cache = commands.add_parser("cache", help="the facts cache: where it is, how big; clear it")
+    cache.add_argument("action", choices=["info", "clear"])
+    cache.add_argument("--cache-path", type=Path, help="the facts cache file")
+    return parser

@@ -1,0 +1,306 @@
+"""The thesis's stated findings, each as a check on what we measured (never a hard-coded answer).
+
+Every check reads the compared series of one subject and says whether our measurement agrees
+with the thesis's words, and what it measured. The tolerances ("about", "near") are stated in
+each rule and in docs/study.md, so a reader can disagree with them on the record.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+from archmetrics.changeset.cost import Sums, location_summary
+from archmetrics.changeset.model import Metrics, Summary
+from archmetrics.reports.model import CompareReport, DiffReport, SeriesReport
+
+LATER = ("first", "second")  # the stages after the baseline
+
+
+@dataclass(frozen=True, slots=True)
+class Verdict:
+    agrees: bool | None  # None: we could not measure it (an approach or stage is missing)
+    measured: str
+
+
+@dataclass(frozen=True, slots=True)
+class Finding:
+    id: str
+    subject: str
+    claim: str  # the thesis's words, condensed
+    pages: str
+    rule: str  # how we test it
+    check: Callable[[Mapping[str, SeriesReport]], Verdict]
+
+
+INTEGRATION = "integration"  # base + framework: the code an approach makes the integrator write
+
+
+def integration_summary(report: DiffReport) -> Summary:
+    """The chapter-6 summary over base and framework together.
+
+    The new capability is the same code in every approach of a subject (the study's control),
+    so claims about what an approach costs are tested on the code around it: the client
+    (base) and what the approach supplies or requires (framework).
+    """
+    chosen = [e for e in report.change.elements if e.location.value in ("base", "framework")]
+    sums = Sums(
+        pre=sum((e.pre or Metrics() for e in chosen), Metrics()),
+        post=sum((e.post or Metrics() for e in chosen), Metrics()),
+        added=sum(e.added for e in chosen),
+        removed=sum(e.removed for e in chosen),
+        modified=sum(e.modified for e in chosen),
+    )
+    return location_summary(sums, ())
+
+
+def summary(series: SeriesReport, stage: str, location: str = INTEGRATION) -> Summary:
+    for s in series.stages:
+        if s.label == stage:
+            if location == INTEGRATION:
+                return integration_summary(s.report)
+            return s.report.summaries()[location]
+    raise KeyError(stage)
+
+
+def _fmt(value: float | None) -> str:
+    return "n/a" if value is None else f"{value:g}" if isinstance(value, int) else f"{value:.2f}"
+
+
+def _series(
+    approaches: Sequence[str],
+) -> Callable[..., Callable[[Mapping[str, SeriesReport]], Verdict]]:
+    """Wrap a check so a missing approach or stage gives 'not measured' instead of an error."""
+
+    def wrap(body: Callable[..., Verdict]) -> Callable[[Mapping[str, SeriesReport]], Verdict]:
+        def check(found: Mapping[str, SeriesReport]) -> Verdict:
+            try:
+                return body(*(found[a] for a in approaches))
+            except KeyError as missing:
+                return Verdict(None, f"not measured: no {missing} in this study")
+
+        return check
+
+    return wrap
+
+
+@_series(["soa"])
+def _wdb_soa_coupling(soa: SeriesReport) -> Verdict:
+    deltas = {
+        stage: tuple(
+            getattr(summary(soa, stage), f)
+            for f in ("delta_s_a", "delta_s_e", "delta_d_a", "delta_d_e")
+        )
+        for stage in LATER
+    }
+    text = "; ".join(f"{st}: Δs_a, Δs_e, Δd_a, Δd_e = {d}" for st, d in deltas.items())
+    return Verdict(all(v == 0 for d in deltas.values() for v in d), text)
+
+
+@_series(["soa"])
+def _wdb_soa_zero_cost(soa: SeriesReport) -> Verdict:
+    parts, ok = [], True
+    for stage in LATER:
+        for loc in ("base", "framework"):
+            s = summary(soa, stage, loc)
+            ok = ok and s.delta_vg == 0 and s.cost == 0
+            parts.append(f"{stage} {loc}: Γ = {s.changes}, ΔVg = {s.delta_vg}, E = {_fmt(s.cost)}")
+    return Verdict(ok, "; ".join(parts))
+
+
+@_series(["player"])
+def _wdb_player_coupling(player: SeriesReport) -> Verdict:
+    got = {st: (summary(player, st).delta_s_e, summary(player, st).delta_d_e) for st in LATER}
+    text = "; ".join(f"{st}: Δs_e = {se}, Δd_e = {de}" for st, (se, de) in got.items())
+    return Verdict(all(v == (1, 2) for v in got.values()), text)
+
+
+@_series(["player"])
+def _wdb_player_growth(player: SeriesReport) -> Verdict:
+    got = {st: summary(player, st) for st in LATER}
+    ok = all(30 <= s.changes <= 40 and 4.5 <= s.scaled_delta_vg <= 7.5 for s in got.values())
+    text = "; ".join(
+        f"{st}: Γ = {s.changes}, ΔVg' = {_fmt(s.scaled_delta_vg)}" for st, s in got.items()
+    )
+    return Verdict(ok, text)
+
+
+@_series(["p2p"])
+def _wdb_p2p_coupling(p2p: SeriesReport) -> Verdict:
+    got = {st: summary(p2p, st).delta_d_e for st in LATER}
+    return Verdict(
+        all(v == 3 for v in got.values()), "; ".join(f"{st}: Δd_e = {v}" for st, v in got.items())
+    )
+
+
+def _largest(
+    approach: str, field: str, stages: Sequence[str], found: Mapping[str, SeriesReport]
+) -> tuple[bool, str]:
+    ok, parts = True, []
+    for stage in stages:
+        values = {name: getattr(summary(s, stage), field) for name, s in found.items()}
+        top = max(values.values(), key=lambda v: v if v is not None else float("-inf"))
+        ok = ok and values[approach] == top
+        parts.append(f"{stage} {field}: " + ", ".join(f"{n} {_fmt(v)}" for n, v in values.items()))
+    return ok, "; ".join(parts)
+
+
+def _wdb_p2p_grows_most(found: Mapping[str, SeriesReport]) -> Verdict:
+    if "p2p" not in found or len(found) < 2:
+        return Verdict(None, "not measured: needs p2p and another approach")
+    size_ok, size = _largest("p2p", "scaled_changes", LATER, found)
+    vg_ok, vg = _largest("p2p", "scaled_delta_vg", LATER, found)
+    return Verdict(size_ok and vg_ok, f"{size}; {vg}")
+
+
+def _prag_soa_largest_de(found: Mapping[str, SeriesReport]) -> Verdict:
+    if "soa" not in found or len(found) < 2:
+        return Verdict(None, "not measured: needs soa and another approach")
+    ok, text = _largest("soa", "delta_d_e", LATER, found)
+    return Verdict(ok, text)
+
+
+def _costs(series: SeriesReport) -> dict[str, float]:
+    return {s.label: summary(series, s.label).cost for s in series.stages}
+
+
+@_series(["soa"])
+def _prag_soa_constant_cost(soa: SeriesReport) -> Verdict:
+    costs = _costs(soa)
+    values = list(costs.values())
+    ok = min(values) > 0 and max(values) / min(values) <= 1.5
+    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in costs.items()))
+
+
+@_series(["player"])
+def _prag_player_jump(player: SeriesReport) -> Verdict:
+    e = _costs(player)
+    ok = e["first"] > e["baseline"] and e["second"] < e["first"]
+    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()))
+
+
+def _prag_p2p_high_rising(found: Mapping[str, SeriesReport]) -> Verdict:
+    if "p2p" not in found:
+        return Verdict(None, "not measured: no p2p in this study")
+    e = _costs(found["p2p"])
+    highest, text = _largest("p2p", "cost", ("second",), found)
+    ok = e["second"] > e["first"] and highest
+    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()) + f"; {text}")
+
+
+@_series(["soa"])
+def _legacy_soa_cost(soa: SeriesReport) -> Verdict:
+    e = _costs(soa)
+    ok = e["baseline"] >= e["first"] and e["second"] <= 1.25 * e["first"]
+    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()))
+
+
+FINDINGS: tuple[Finding, ...] = (
+    Finding(
+        "wdb-soa-coupling",
+        "wdb",
+        "SOA: coupling does not change after the baseline",
+        "119",
+        "Δs_a = Δs_e = Δd_a = Δd_e = 0 in base + framework at the first and second stages",
+        _wdb_soa_coupling,
+    ),
+    Finding(
+        "wdb-soa-cost",
+        "wdb",
+        "SOA: each added operation is about two client lines and one"
+        " dispatch line, so ΔVg = 0 and E = 0",
+        "122",
+        "ΔVg = 0 and E = 0 in base and framework at the first and second stages",
+        _wdb_soa_zero_cost,
+    ),
+    Finding(
+        "wdb-player-coupling",
+        "wdb",
+        "Player: each added message gives +1 static efferent and +2 dynamic efferent coupling",
+        "119-120",
+        "Δs_e = 1 and Δd_e = 2 in base + framework at the first and second stages",
+        _wdb_player_coupling,
+    ),
+    Finding(
+        "wdb-player-growth",
+        "wdb",
+        "Player: code grows 30-40 lines a stage with scaled complexity near 6",
+        "122",
+        "30 ≤ Γ ≤ 40 and 4.5 ≤ ΔVg' ≤ 7.5 in base + framework at the first and second stages",
+        _wdb_player_growth,
+    ),
+    Finding(
+        "wdb-p2p-coupling",
+        "wdb",
+        "P2P: +3 dynamic efferent coupling per message (accept, send, recv)",
+        "120",
+        "Δd_e = 3 in base + framework at the first and second stages",
+        _wdb_p2p_coupling,
+    ),
+    Finding(
+        "wdb-p2p-growth",
+        "wdb",
+        "P2P: size and complexity grow the most",
+        "122-123",
+        "P2P has the largest Γ' and ΔVg' in base + framework at the first and second stages",
+        _wdb_p2p_grows_most,
+    ),
+    Finding(
+        "prag-soa-coupling",
+        "pragmatics",
+        "SOA has the largest dynamic efferent coupling",
+        "132",
+        "SOA has the largest Δd_e in base + framework at the first and second stages",
+        _prag_soa_largest_de,
+    ),
+    Finding(
+        "prag-soa-cost",
+        "pragmatics",
+        "SOA: near-constant complexity change cost E across stages",
+        "133",
+        "E of base + framework > 0 at every stage, max/min ≤ 1.5",
+        _prag_soa_constant_cost,
+    ),
+    Finding(
+        "prag-player-cost",
+        "pragmatics",
+        "Player: E jumps at the first stage and drops at the second",
+        "133-135",
+        "in base + framework, E(first) > E(baseline) and E(second) < E(first)",
+        _prag_player_jump,
+    ),
+    Finding(
+        "prag-p2p-cost",
+        "pragmatics",
+        "P2P: E is high and rises",
+        "135",
+        "in base + framework, E(second) > E(first), and P2P's E(second) is the largest",
+        _prag_p2p_high_rising,
+    ),
+    Finding(
+        "legacy-soa-cost",
+        "legacy",
+        "SOA: E is large at the baseline and stable or falling afterwards",
+        "142",
+        "in base + framework, E(first) ≤ E(baseline) and E(second) ≤ 1.25·E(first)",
+        _legacy_soa_cost,
+    ),
+)
+
+
+@dataclass(frozen=True, slots=True)
+class Outcome:
+    finding: Finding
+    verdict: Verdict
+
+
+def check_findings(subjects: Mapping[str, CompareReport]) -> tuple[Outcome, ...]:
+    """Every finding whose subject was measured, with its verdict."""
+    outcomes = []
+    for finding in FINDINGS:
+        report = subjects.get(finding.subject)
+        if report is None:
+            outcomes.append(Outcome(finding, Verdict(None, "not measured: subject not in study")))
+            continue
+        outcomes.append(Outcome(finding, finding.check(dict(report.series))))
+    return tuple(outcomes)

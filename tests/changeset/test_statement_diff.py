@@ -1,0 +1,115 @@
+"""The pairing rule on hand-built statement sequences, and its invariants (hypothesis)."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from archmetrics.changeset import statement_diff
+from archmetrics.changeset.statement_diff import Action, diff_statements, similarity
+from archmetrics.facts import Span, Statement
+
+
+def stmts(*items: tuple[str, str]) -> tuple[Statement, ...]:
+    """Statements on consecutive lines from (kind, text) pairs."""
+    return tuple(Statement(kind, Span(n, n), text) for n, (kind, text) in enumerate(items, 1))
+
+
+A = ("assign", "x = 1")
+B = ("call", "f(x)")
+C = ("return", "return x")
+
+
+def counts(pre: tuple[Statement, ...], post: tuple[Statement, ...]) -> tuple[int, int, int]:
+    change = diff_statements(pre, post)
+    return change.added, change.removed, change.modified
+
+
+def test_identical_is_zero() -> None:
+    assert counts(stmts(A, B, C), stmts(A, B, C)) == (0, 0, 0)
+
+
+def test_insert_and_delete() -> None:
+    assert counts(stmts(A, C), stmts(A, B, C)) == (1, 0, 0)
+    assert counts(stmts(A, B, C), stmts(A, C)) == (0, 1, 0)
+
+
+def test_same_kind_in_place_is_modified_with_spans_on_both_sides() -> None:
+    change = diff_statements(stmts(A, ("if", "if x > 0:"), C), stmts(A, ("if", "if x >= 0:"), C))
+    assert (change.added, change.removed, change.modified) == (0, 0, 1)
+    (only,) = change.changes
+    assert only.action is Action.MODIFIED
+    assert only.pre is not None and only.pre.text == "if x > 0:" and only.pre.span == Span(2, 2)
+    assert only.post is not None and only.post.text == "if x >= 0:"
+    assert only.similarity is not None and 0.5 < only.similarity < 1
+
+
+def test_different_kind_pairs_only_when_similar() -> None:
+    # assignment dropped, call kept: similar tokens -> modified
+    assert counts(stmts(("assign", "y = f(a, b)")), stmts(("call", "f(a, b)"))) == (0, 0, 1)
+    # unrelated kinds and texts -> removed + added
+    assert counts(stmts(("assign", "y = 1")), stmts(("call", "go()"))) == (1, 1, 0)
+
+
+def test_pairing_prefers_the_most_similar_partner() -> None:
+    pre = stmts(A, ("call", "send(a, b)"), C)
+    post = stmts(A, ("call", "send(a, b, c)"), ("call", "log()"), C)
+    change = diff_statements(pre, post)
+    assert (change.added, change.removed, change.modified) == (1, 0, 1)
+    modified = next(c for c in change.changes if c.action is Action.MODIFIED)
+    assert modified.post is not None and modified.post.text == "send(a, b, c)"
+
+
+def test_moved_statement_is_removed_and_added_and_flagged() -> None:
+    change = diff_statements(stmts(A, B, C), stmts(B, C, A))
+    assert (change.added, change.removed, change.modified) == (1, 1, 0)
+    assert all(c.moved for c in change.changes)
+
+
+def test_similarity_is_over_tokens() -> None:
+    assert similarity("count = 0", "n = 0") == 2 * 2 / 6
+    assert similarity("", "") == 1.0
+
+
+def test_huge_replace_runs_pair_greedily_and_say_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    pre = stmts(*[("call", f"old_{i}(a)") for i in range(30)])
+    post = stmts(*[("call", f"new_{i}(a)") for i in range(30)])
+    exact = diff_statements(pre, post)
+    assert not exact.approximate and exact.modified == 30
+    monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 100)
+    rough = diff_statements(pre, post)
+    assert rough.approximate and rough.modified == 30
+
+
+_KINDS = st.sampled_from(["assign", "call", "if", "return"])
+_TEXTS = st.sampled_from(["x = 1", "x = 2", "f(x)", "g(y, z)", "if a:", "return b", ""])
+_SEQ = st.lists(st.tuples(_KINDS, _TEXTS), max_size=25)
+
+
+@settings(max_examples=200, deadline=None)
+@given(_SEQ, _SEQ)
+def test_counts_balance_and_are_never_negative(
+    pre_items: list[tuple[str, str]], post_items: list[tuple[str, str]]
+) -> None:
+    pre, post = stmts(*pre_items), stmts(*post_items)
+    change = diff_statements(pre, post)
+    assert change.added - change.removed == len(post) - len(pre)
+    assert min(change.added, change.removed, change.modified) >= 0
+    assert change.removed + change.modified <= len(pre)
+    assert change.added + change.modified <= len(post)
+    assert len(change.changes) == change.total
+    pairs = [c for c in change.changes if c.action is Action.MODIFIED]
+    for c in pairs:
+        assert c.pre is not None and c.post is not None
+        assert c.pre.kind == c.post.kind or similarity(c.pre.text, c.post.text) >= 0.5
+    pre_lines = [c.pre.span.start for c in pairs if c.pre]
+    post_lines = [c.post.span.start for c in pairs if c.post]
+    assert pre_lines == sorted(pre_lines) and post_lines == sorted(post_lines)  # no crossing
+
+
+@settings(max_examples=100, deadline=None)
+@given(_SEQ)
+def test_identical_sequences_count_zero(items: list[tuple[str, str]]) -> None:
+    change = diff_statements(stmts(*items), stmts(*items))
+    assert change.total == 0 and change.changes == ()
