@@ -1,0 +1,262 @@
+"""Read a descriptor: parse the XML, validate it against the shipped schema, build the facts.
+
+Semantic checks live in :mod:`robosoa.descriptor.checks`; this module only turns text into
+:class:`ServiceDescriptor` and reports syntax and schema errors with file, line and field.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from .checks import check
+from .errors import DescriptorError, Problem
+from .model import (
+    Actor,
+    Command,
+    Encoding,
+    Function,
+    Implementation,
+    ImplementationForm,
+    Language,
+    Naming,
+    OperatingSystem,
+    Operation,
+    Packaging,
+    Parameter,
+    Participant,
+    Pattern,
+    Profile,
+    ServiceDescriptor,
+    TypeDef,
+    TypeRef,
+)
+
+_Element = etree._Element
+
+_LABELS = {
+    "operation": "operation",
+    "param": "parameter",
+    "return": "return",
+    "struct": "type",
+    "field": "field",
+    "command": "command",
+    "function": "function",
+}
+_SCHEMA_PREFIX = re.compile(r"^Element '[^']+'(?:, attribute '(?P<attr>[^']+)')?: ")
+
+
+@cache
+def schema() -> etree.XMLSchema:
+    """The shipped XML Schema (robosoa/data/descriptor.xsd), parsed once."""
+    data = resources.files("robosoa").joinpath("data/descriptor.xsd").read_bytes()
+    return etree.XMLSchema(etree.fromstring(data))
+
+
+def load(path: str | Path) -> ServiceDescriptor:
+    """Load and validate the descriptor file at ``path``; raise :class:`DescriptorError`."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DescriptorError([Problem(str(path), 0, "", f"cannot read: {exc}")]) from None
+    return loads(text, source=str(path))
+
+
+def loads(text: str, source: str = "<descriptor>") -> ServiceDescriptor:
+    """Parse and validate descriptor ``text``; ``source`` names it in error messages."""
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    try:
+        root = etree.fromstring(text.encode("utf-8"), parser)
+    except etree.XMLSyntaxError as exc:
+        line = exc.lineno or 0
+        raise DescriptorError(
+            [Problem(source, line, "", f"not well-formed XML: {exc.msg}")]
+        ) from None
+    validator = schema()
+    if not validator.validate(root):
+        raise DescriptorError(_schema_problems(root, validator, source))
+    descriptor = _service(root, source, text)
+    problems = check(descriptor)
+    if problems:
+        raise DescriptorError(problems)
+    return descriptor
+
+
+def describe(element: _Element) -> str:
+    """Name an element as a reader would: ``operation 'query' parameter 'x'``."""
+    parts: list[str] = []
+    node: _Element | None = element
+    while node is not None:
+        tag = str(node.tag)
+        if tag in _LABELS:
+            label = _LABELS[tag]
+            key = node.get("name") or node.get("operation")
+            parts.append(f"{label} '{key}'" if key else label)
+        elif tag == "participant":
+            parts.append(f"participant '{node.get('packaging')}'")
+        elif tag != "service":
+            parts.append(tag)
+        node = node.getparent()
+    return " ".join(reversed(parts)) or "service"
+
+
+def _schema_problems(root: _Element, validator: etree.XMLSchema, source: str) -> list[Problem]:
+    problems = []
+    entries: Iterable[Any] = validator.error_log  # type: ignore[assignment]
+    for entry in entries:
+        found = root.getroottree().xpath(entry.path) if entry.path else []
+        element = found[0] if isinstance(found, list) and found else root
+        field = describe(element) if isinstance(element, _Element) else "service"
+        message = entry.message
+        match = _SCHEMA_PREFIX.match(message)
+        if match:
+            message = message[match.end() :]
+            if match.group("attr"):
+                field += f" attribute '{match.group('attr')}'"
+        problems.append(Problem(source, entry.line, field, message.rstrip(".")))
+    return problems
+
+
+def parse_type(text: str) -> TypeRef:
+    """Parse a type expression (``int``, ``Row``, ``list[list[float]]``).
+
+    A malformed expression becomes a TypeRef named by the whole text, which the semantic
+    checks then report as an unknown type.
+    """
+    if text.startswith("list[") and text.endswith("]"):
+        return TypeRef("list", parse_type(text[5:-1]))
+    return TypeRef(text)
+
+
+def _line(element: _Element) -> int:
+    line: object = element.sourceline  # the lxml stubs leave this untyped
+    return line if isinstance(line, int) else 0
+
+
+def _required(element: _Element, name: str) -> str:
+    return element.get(name) or ""
+
+
+def _text(element: _Element | None) -> str:
+    return " ".join((element.text or "").split()) if element is not None else ""
+
+
+def _typed(element: _Element) -> Parameter:
+    default = element.get("default")
+    required = element.get("required")
+    is_required = required in ("true", "1") if required is not None else default is None
+    return Parameter(
+        name=element.get("name", ""),
+        type=parse_type(element.get("type", "")),
+        required=is_required,
+        default=default,
+        definition=element.get("definition", ""),
+        line=_line(element),
+    )
+
+
+def _operation(element: _Element) -> Operation:
+    return Operation(
+        name=element.get("name", ""),
+        parameters=tuple(_typed(e) for e in element.findall("param")),
+        returns=tuple(_typed(e) for e in element.findall("return")),
+        definition=_text(element.find("definition")),
+        line=_line(element),
+    )
+
+
+def _struct(element: _Element) -> TypeDef:
+    return TypeDef(
+        name=element.get("name", ""),
+        fields=tuple(_typed(e) for e in element.findall("field")),
+        definition=_text(element.find("definition")),
+        line=_line(element),
+    )
+
+
+def _implementation(element: _Element | None) -> Implementation | None:
+    if element is None:
+        return None
+    return Implementation(
+        form=ImplementationForm(_required(element, "form")),
+        library=element.get("library"),
+        encoding=Encoding(element.get("encoding", "json")),
+        timeout=float(element.get("timeout", "30")),
+        commands=tuple(
+            Command(e.get("operation"), (e.text or "").strip(), _line(e))
+            for e in element.findall("command")
+        ),
+        functions=tuple(
+            Function(e.get("operation", ""), e.get("symbol", ""), _line(e))
+            for e in element.findall("function")
+        ),
+        line=_line(element),
+    )
+
+
+def default_naming(service: str, packaging: Packaging, library: str | None) -> Naming:
+    """Package, module and class names used when ``<naming>`` leaves them out."""
+    camel = "".join(part[:1].upper() + part[1:] for part in service.split("_"))
+    if packaging is Packaging.CONSUMER_SOURCE:
+        return Naming(f"{service}_client", "client", f"{camel}Client")
+    if packaging is Packaging.CONSUMER_NO_SOURCE:
+        package = library.rsplit(".", 1)[-1] if library else f"{service}_api"
+        return Naming(package, "api", f"{camel}Api")
+    return Naming(f"{service}_provider", "provider", f"{camel}Provider")
+
+
+def _naming(element: _Element | None, defaults: Naming) -> Naming:
+    if element is None:
+        return defaults
+    return Naming(
+        package=element.get("package", defaults.package),
+        module=element.get("module", defaults.module),
+        class_name=element.get("class", defaults.class_name),
+    )
+
+
+def _participant(element: _Element, service: str) -> Participant:
+    packaging = Packaging(_required(element, "packaging"))
+    target = element.find("target")
+    implementation = _implementation(element.find("implementation"))
+    naming = element.find("naming")
+    defaults = default_naming(
+        service, packaging, implementation.library if implementation else None
+    )
+    codegen = element.find("codegen")
+    return Participant(
+        actor=Actor(_required(element, "actor")),
+        packaging=packaging,
+        language=Language(target.get("language", "python") if target is not None else "python"),
+        os=OperatingSystem(target.get("os", "any") if target is not None else "any"),
+        implementation=implementation,
+        profile=Profile(codegen.get("profile", "checked") if codegen is not None else "checked"),
+        naming=_naming(naming, defaults),
+        group=element.get("group"),
+        line=_line(element),
+    )
+
+
+def _service(root: _Element, source: str, text: str) -> ServiceDescriptor:
+    name = root.get("name", "")
+    pattern = root.find("pattern")
+    types = root.find("types")
+    return ServiceDescriptor(
+        name=name,
+        version=root.get("version", ""),
+        definition=_text(root.find("definition")),
+        pattern=Pattern(_text(pattern)),
+        delivery=pattern.get("delivery", "one") if pattern is not None else "one",
+        types=tuple(_struct(e) for e in types.findall("struct")) if types is not None else (),
+        operations=tuple(_operation(e) for e in root.findall("operation")),
+        participants=tuple(_participant(e, name) for e in root.findall("participant")),
+        source=source,
+        text=text,
+        line=_line(root),
+    )

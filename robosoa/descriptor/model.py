@@ -1,0 +1,256 @@
+"""Frozen facts of a service descriptor (Hestand 2011, p. 93-94 and Appendix A field list).
+
+Every fact carries the descriptor line it came from, so a later check or a generated file can
+point back at the XML that produced it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Any
+
+
+class Pattern(StrEnum):
+    """Message exchange patterns of the thesis (p. 62)."""
+
+    REQUEST_RESPONSE = "request-response"
+    PUBLISH_SUBSCRIBE = "publish-subscribe"
+    ONE_WAY = "one-way"
+    EVENT = "event"
+    POINT_TO_POINT = "point-to-point"
+
+    @property
+    def has_replies(self) -> bool:
+        """Whether operations under this pattern may declare return values."""
+        return self in (Pattern.REQUEST_RESPONSE, Pattern.POINT_TO_POINT)
+
+
+class Actor(StrEnum):
+    """The side of the service a participant plays."""
+
+    PROVIDER = "provider"
+    CONSUMER = "consumer"
+
+
+class Packaging(StrEnum):
+    """Packaging form factors (thesis p. 94)."""
+
+    PROVIDER_EXECUTABLE = "provider-executable"
+    PROVIDER_LIBRARY = "provider-library"
+    CONSUMER_SOURCE = "consumer-source"
+    CONSUMER_NO_SOURCE = "consumer-no-source"
+
+    @property
+    def actor(self) -> Actor:
+        """The actor this packaging form belongs to."""
+        return Actor.PROVIDER if self.value.startswith("provider") else Actor.CONSUMER
+
+
+class ImplementationForm(StrEnum):
+    """How the code behind a participant is delivered: a program, a library or source."""
+
+    EXECUTABLE = "executable"
+    LIBRARY = "library"
+    SOURCE = "source"
+
+
+class Language(StrEnum):
+    """Language of the code a participant binds to (generated code is always Python)."""
+
+    PYTHON = "python"
+    C = "c"
+    ANY = "any"
+
+
+class OperatingSystem(StrEnum):
+    """Operating systems a participant may be generated for."""
+
+    ANY = "any"
+    POSIX = "posix"
+    LINUX = "linux"
+    MACOS = "macos"
+    WINDOWS = "windows"
+
+
+class Encoding(StrEnum):
+    """How a provider-executable passes requests on stdin and reads results from stdout."""
+
+    JSON = "json"
+    XML = "xml"
+    TEXT = "text"
+
+
+class Profile(StrEnum):
+    """Code generation profiles: whether generated code checks payloads against the types."""
+
+    CHECKED = "checked"
+    UNCHECKED = "unchecked"
+
+
+PRIMITIVES: tuple[str, ...] = ("int", "float", "bool", "string")
+
+
+@dataclass(frozen=True, slots=True)
+class TypeRef:
+    """A data type expression: a primitive, a named struct, or ``list[...]`` of a type."""
+
+    name: str
+    item: TypeRef | None = None
+
+    @property
+    def is_list(self) -> bool:
+        """Whether this is ``list[item]``."""
+        return self.item is not None
+
+    @property
+    def is_primitive(self) -> bool:
+        """Whether this is one of :data:`PRIMITIVES`."""
+        return self.item is None and self.name in PRIMITIVES
+
+    def __str__(self) -> str:
+        return f"list[{self.item}]" if self.item is not None else self.name
+
+
+@dataclass(frozen=True, slots=True)
+class Parameter:
+    """A call parameter, a return value or a struct field: name, type and optional default."""
+
+    name: str
+    type: TypeRef
+    required: bool
+    default: str | None
+    definition: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class TypeDef:
+    """A named struct type defined in the descriptor's ``<types>``."""
+
+    name: str
+    fields: tuple[Parameter, ...]
+    definition: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class Operation:
+    """An operation with its call parameters and return values."""
+
+    name: str
+    parameters: tuple[Parameter, ...]
+    returns: tuple[Parameter, ...]
+    definition: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """A program a provider-executable runs; ``operation`` None means every operation."""
+
+    operation: str | None
+    argv: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class Function:
+    """Maps an operation to a library symbol (Python function or C function name)."""
+
+    operation: str
+    symbol: str
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class Implementation:
+    """Implementation form factor and the details each form needs."""
+
+    form: ImplementationForm
+    library: str | None
+    encoding: Encoding
+    timeout: float
+    commands: tuple[Command, ...]
+    functions: tuple[Function, ...]
+    line: int
+
+    def symbol(self, operation: str) -> str:
+        """The library symbol that implements ``operation`` (defaults to its name)."""
+        return next((f.symbol for f in self.functions if f.operation == operation), operation)
+
+    def command(self, operation: str) -> Command | None:
+        """The command that serves ``operation``: its own, else the catch-all one."""
+        own = [c for c in self.commands if c.operation == operation]
+        general = [c for c in self.commands if c.operation is None]
+        chosen = own or general
+        return chosen[0] if chosen else None
+
+
+@dataclass(frozen=True, slots=True)
+class Naming:
+    """Names of the generated package, module and class."""
+
+    package: str
+    module: str
+    class_name: str
+
+
+@dataclass(frozen=True, slots=True)
+class Participant:
+    """One consumer or provider of the service, packaged in one form."""
+
+    actor: Actor
+    packaging: Packaging
+    language: Language
+    os: OperatingSystem
+    implementation: Implementation | None
+    profile: Profile
+    naming: Naming
+    group: str | None
+    line: int
+
+
+@dataclass(frozen=True, slots=True)
+class ServiceDescriptor:
+    """A whole service profile: interface, data types and the participants to generate."""
+
+    name: str
+    version: str
+    definition: str
+    pattern: Pattern
+    delivery: str
+    types: tuple[TypeDef, ...]
+    operations: tuple[Operation, ...]
+    participants: tuple[Participant, ...]
+    source: str
+    text: str = field(repr=False)
+    line: int = 0
+
+    def operation(self, name: str) -> Operation | None:
+        """The operation called ``name``, if any."""
+        return next((op for op in self.operations if op.name == name), None)
+
+    def type(self, name: str) -> TypeDef | None:
+        """The struct type called ``name``, if any."""
+        return next((t for t in self.types if t.name == name), None)
+
+    def participant(self, packaging: Packaging) -> Participant | None:
+        """The participant packaged as ``packaging``, if the descriptor declares one."""
+        return next((p for p in self.participants if p.packaging == packaging), None)
+
+    def validator(self) -> Callable[[str, Mapping[str, Any]], None]:
+        """A request checker ``(operation, payload) -> None`` for ``bus.provide(validator=)``.
+
+        It raises ``robosoa.InvalidMessage`` naming the operation and the offending field.
+        """
+        from .payload import request_validator
+
+        return request_validator(self)
+
+    def reply_validator(self) -> Callable[[str, Mapping[str, Any]], None]:
+        """Like :meth:`validator`, for reply payloads against the declared return values."""
+        from .payload import reply_validator
+
+        return reply_validator(self)
