@@ -102,8 +102,17 @@ def _int(value: Any, where: str) -> int:
 
 def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
     """Settings from the archmetrics table of a config file (already TOML-decoded)."""
-    known = {"languages", "exclude", "include-generated", "locations", "coupling", "gates",
-             "cache-path", "cache", "jobs"}
+    known = {
+        "languages",
+        "exclude",
+        "include-generated",
+        "locations",
+        "coupling",
+        "gates",
+        "cache-path",
+        "cache",
+        "jobs",
+    }
     _check_keys(table, known, source)
     values: dict[str, Any] = {"source": source}
     for key, value in table.items():
@@ -132,7 +141,7 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
 
 
 def load_settings(root: Path) -> Settings:
-    """Settings from the first of ``archmetrics.toml``, ``pyproject.toml`` in ``root`` that has any."""
+    """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``."""
     for name in CONFIG_FILES:
         path = root / name
         if not path.is_file():

@@ -29,7 +29,11 @@ class GitRepo:
         env = {**os.environ, **_ENV}
         done = subprocess.run(
             ["git", "-c", "commit.gpgsign=false", *args],
-            cwd=self.root, env=env, check=True, capture_output=True, text=True,
+            cwd=self.root,
+            env=env,
+            check=True,
+            capture_output=True,
+            text=True,
         )
         return done.stdout
 
@@ -45,7 +49,9 @@ class GitRepo:
     def remove(self, *paths: str) -> None:
         self.git("rm", "-q", *paths)
 
-    def commit(self, message: str, tag: str | None = None, files: Mapping[str, str | bytes] = {}) -> str:
+    def commit(
+        self, message: str, tag: str | None = None, files: Mapping[str, str | bytes] = {}
+    ) -> str:
         if files:
             self.write(files)
         self.git("add", "-A")

@@ -17,7 +17,7 @@ def test_pyproject_table(tmp_path: Path) -> None:
     (tmp_path / "pyproject.toml").write_text(
         '[tool.archmetrics]\nlanguages = { ".h" = "c" }\nexclude = ["vendor/**"]\n'
         '[tool.archmetrics.locations]\nnew = ["wdb/**"]\n'
-        '[tool.archmetrics.coupling]\nper-file = true\n'
+        "[tool.archmetrics.coupling]\nper-file = true\n"
     )
     settings = load_settings(tmp_path)
     assert settings.languages == ((".h", "c"),)
