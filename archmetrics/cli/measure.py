@@ -30,7 +30,24 @@ from archmetrics.reports.formats import (
     render_scan,
     render_series,
 )
+from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources.git import tags_in_order
+
+
+def write_chart(args: argparse.Namespace, report: CompareReport) -> None:
+    """The chart --chart asks for, in the format its file ending names."""
+    if args.chart is None:
+        return
+    from archmetrics.reports.charts import render_compare_chart
+
+    fmt = args.chart.suffix.lower().lstrip(".")
+    if fmt not in ("png", "svg"):
+        raise UsageError(f"{args.chart}: --chart needs a .png or .svg file")
+    data = render_compare_chart(report, args.chart_kind, fmt)
+    try:
+        args.chart.write_bytes(data)
+    except OSError as error:
+        raise UsageError(f"{args.chart}: cannot write: {error.strerror}") from error
 
 
 def cache_command(args: argparse.Namespace) -> int:
@@ -127,6 +144,7 @@ def series_command(args: argparse.Namespace) -> int:
     with facts_cache(args, request.diff.settings) as cache:
         report = run_series(request, progress_for(fmt, args.quiet), cache)
     emit(render_series(report, fmt), args.output)
+    write_chart(args, CompareReport(((Path(args.repo).resolve().name, report),)))
     return gate_status(report.failures)
 
 
@@ -141,6 +159,7 @@ def compare_command(args: argparse.Namespace) -> int:
     with facts_cache(args, named[0][1].diff.settings) as cache:
         report = run_compare(named, progress_for(fmt, args.quiet), cache)
     emit(render_compare(report, fmt), args.output)
+    write_chart(args, report)
     return gate_status(report.failures)
 
 
@@ -151,4 +170,9 @@ def diff_command(args: argparse.Namespace) -> int:
     with facts_cache(args, settings) as cache:
         report = run_diff(request, progress_for(fmt, args.quiet), cache)
     emit(render_diff(report, fmt), args.output)
+    stage = Stage(f"{args.base}..{args.head}", report)
+    write_chart(
+        args,
+        CompareReport(((Path(args.repo).resolve().name, SeriesReport(str(args.repo), (stage,))),)),
+    )
     return gate_status(report.failures)

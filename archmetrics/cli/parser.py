@@ -8,6 +8,7 @@ from pathlib import Path
 
 from archmetrics import __version__
 from archmetrics.cli.common import Parser
+from archmetrics.reports.charts import chart_kinds
 from archmetrics.reports.formats import Grouping, OutputFormat
 
 
@@ -18,6 +19,15 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
     parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     parser.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     parser.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+
+
+def add_chart(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--chart", type=Path, metavar="FILE", help="also draw a chart into FILE (.png or .svg)"
+    )
+    parser.add_argument(
+        "--chart-kind", default="cost", choices=chart_kinds(), help="which chart (default: cost)"
+    )
 
 
 def add_locations(parser: argparse.ArgumentParser) -> None:
@@ -60,6 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     diff.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
     add_locations(diff)
+    add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
@@ -69,6 +80,7 @@ def build_parser() -> argparse.ArgumentParser:
     series.add_argument("--root", default="EMPTY", help="what the first stage is measured against")
     series.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
     add_locations(series)
+    add_chart(series)
     add_output(series, [f.value for f in OutputFormat])
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
@@ -81,6 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--labels", help="comma-separated stage names")
     compare.add_argument("--root", default="EMPTY", help="what the first stage is measured against")
     add_locations(compare)
+    add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"

@@ -1,0 +1,216 @@
+"""C and C++ statements (λ): each captured node becomes one Statement with its normal text.
+
+Which node types count is the table in ``c_tables``; this module only cuts each node down
+to its own part (a header, a label) and normalizes that part's text.
+"""
+
+from __future__ import annotations
+
+import bisect
+import re
+from collections.abc import Callable, Mapping
+
+from tree_sitter import Node, Point
+
+from archmetrics.facts import Span, Statement
+from archmetrics.parsers.c_family_names import text
+from archmetrics.parsers.c_family_text import compact, normal, normal_many, without
+from archmetrics.parsers.c_tables import Shape, StatementRule
+
+_NOT_COUNTED_DIRECTIVES = frozenset({"#pragma once", "#"})
+_GUARD_CONDITION = re.compile(r"!defined\(?(\w+)\)?")
+
+# (start byte, end byte, first row, last row, prefix, kind)
+_Extent = tuple[int, int, int, int, bytes, str]
+
+
+def _last_row(point: Point) -> int:
+    """The 0-based row a node ending at ``point`` ends on (a trailing newline does not count)."""
+    return point.row if point.column else point.row - 1
+
+
+def _previous_token(node: Node) -> Node | None:
+    previous = node.prev_sibling
+    while previous is not None and previous.type == "comment":
+        previous = previous.prev_sibling
+    return previous
+
+
+def _header(node: Node, rule: StatementRule) -> _Extent | None:
+    body = node.child_by_field_name(rule.body_field)
+    if body is None:
+        return None
+    last = _previous_token(body)
+    if last is None:
+        return node.start_byte, body.start_byte, node.start_point.row, body.start_point.row, b"", ""
+    return node.start_byte, last.end_byte, node.start_point.row, _last_row(last.end_point), b"", ""
+
+
+def _label(node: Node) -> _Extent | None:
+    first = node.child(0)
+    kind = "default" if first is not None and first.type == "default" else "case"
+    for index in range(1, 8):
+        child = node.child(index)
+        if child is None:
+            break
+        if child.type == ":":
+            end = child.end_point.row
+            return node.start_byte, child.end_byte, node.start_point.row, end, b"", kind
+    return None
+
+
+def _do_while(node: Node) -> _Extent | None:
+    condition = node.child_by_field_name("condition")
+    keyword = _previous_token(condition) if condition is not None else None
+    if keyword is None or keyword.type != "while":
+        return None
+    last = _last_row(node.end_point)
+    return keyword.start_byte, node.end_byte, keyword.start_point.row, last, b"do ", ""
+
+
+def _extent(node: Node, rule: StatementRule) -> _Extent:
+    """The byte and row range of the statement's own part, a text prefix, a kind override."""
+    shaped: _Extent | None = None
+    if rule.shape is Shape.HEADER:
+        shaped = _header(node, rule)
+    elif rule.shape is Shape.LABEL:
+        shaped = _label(node)
+    elif rule.shape is Shape.DO_WHILE:
+        shaped = _do_while(node)
+    if shaped is not None:
+        return shaped
+    first = node.start_point.row
+    return node.start_byte, node.end_byte, first, max(first, _last_row(node.end_point)), b"", ""
+
+
+class Bodies:
+    """Nested bodies (blocks, member lists) by position, to cut out of statement texts."""
+
+    def __init__(self, nodes: list[Node]) -> None:
+        ranges = sorted((node.start_byte, node.end_byte) for node in nodes)
+        self._starts = [start for start, _ in ranges]
+        self._ends = [end for _, end in ranges]
+
+    def inside(self, start: int, end: int) -> list[tuple[int, int]]:
+        """The outermost bodies lying wholly inside [start, end)."""
+        cuts: list[tuple[int, int]] = []
+        index = bisect.bisect_left(self._starts, start)
+        last_end = start
+        while index < len(self._starts) and self._starts[index] < end:
+            body_start, body_end = self._starts[index], self._ends[index]
+            if body_start >= last_end and body_end <= end:
+                cuts.append((body_start, body_end))
+                last_end = body_end
+            index += 1
+        return cuts
+
+
+def _piece(start: int, end: int, clean: bytes, bodies: Bodies) -> bytes:
+    """The statement's own bytes, comments blanked and nested bodies cut to `{ }`."""
+    raw = clean[start:end]
+    if b"{" in raw:
+        cuts = bodies.inside(start, end)
+        if cuts:
+            raw = without(raw, start, cuts)
+    return raw
+
+
+def _fixed_text(node: Node, start: int, end: int, clean: bytes) -> str | None:
+    """The text of the few statements normalized one by one (includes, directives)."""
+    kind = node.type
+    if kind == "preproc_include":
+        target = node.child_by_field_name("path")
+        if target is not None:
+            return "#include " + compact(text(target, clean))
+    if kind.startswith("preproc_"):
+        return normal(clean[start:end])
+    return None
+
+
+def _bounds(node: Node, rule: StatementRule, templates: Mapping[int, tuple[int, int]]) -> _Extent:
+    """Bytes and rows of the statement's own part; a template starts at its `template`."""
+    if rule.shape is Shape.WHOLE:  # the common case, kept cheap
+        end_point = node.end_point
+        last = end_point.row if end_point.column else end_point.row - 1
+        bounds = (node.start_byte, node.end_byte, node.start_point.row, last, b"", "")
+    else:
+        bounds = _extent(node, rule)
+    if bounds[0] in templates:
+        start, first = templates[bounds[0]]
+        return start, bounds[1], first, bounds[3], bounds[4], bounds[5]
+    return bounds
+
+
+def statements(
+    nodes: list[Node],
+    rules: Mapping[str, StatementRule],
+    bodies: Bodies,
+    clean: bytes,
+    templates: Mapping[int, tuple[int, int]],
+    owner: Callable[[int], str | None],
+) -> list[Statement]:
+    """One Statement per counted node; ``owner`` names (and counts in) the enclosing function.
+
+    ``clean`` is the file with comments blanked. Texts are normalized in one batch at the end.
+    """
+    heads: list[tuple[str, int, int, str, str | None]] = []
+    pieces: list[bytes] = []
+    fixed: dict[int, str] = {}
+    for node in nodes:
+        kind = node.type
+        if kind == "expression_statement" and node.named_child_count == 0:
+            continue  # the empty statement `;`
+        rule = rules[kind]
+        start, end, first, last, prefix, override = _bounds(node, rule, templates)
+        if kind[0] == "p":  # preproc_*: normalized one by one, some do not count
+            own = _fixed_text(node, start, end, clean)
+            if own in _NOT_COUNTED_DIRECTIVES:
+                continue
+            if own is not None:
+                fixed[len(pieces)] = own
+        pieces.append(b"" if len(pieces) in fixed else _piece(start, end, clean, bodies))
+        kind_name = override or rule.kind
+        heads.append((kind_name, first, max(first, last), prefix.decode(), owner(node.start_byte)))
+    texts = normal_many(pieces)
+    for index, own in fixed.items():
+        texts[index] = own
+    return [
+        Statement(kind, Span(first + 1, last + 1), prefix + texts[index], function)
+        for index, (kind, first, last, prefix, function) in enumerate(heads)
+    ]
+
+
+def include_guard(root: Node, data: bytes) -> int | None:
+    """The node id of an include guard's `#define`, when the whole file sits inside the guard."""
+    top = [
+        node
+        for node in root.named_children
+        if node.type != "comment"
+        and not (node.type == "preproc_call" and normal(text(node, data)) == "#pragma once")
+    ]
+    if len(top) != 1 or top[0].child_by_field_name("alternative") is not None:
+        return None
+    guard = top[0]
+    inside = [node for node in guard.named_children if node.type != "comment"]
+    if len(inside) < 2 or inside[1].type != "preproc_def":
+        return None
+    if guard.type == "preproc_ifdef" and guard.child(0) is not None:
+        keyword = guard.child(0)
+        if keyword is None or keyword.type != "#ifndef":
+            return None
+        name = compact(text(inside[0], data))
+    elif guard.type == "preproc_if":
+        match = _GUARD_CONDITION.fullmatch(compact(text(inside[0], data)))
+        if match is None:
+            return None
+        name = match.group(1)
+    else:
+        return None
+    define = inside[1]
+    defined = define.child_by_field_name("name")
+    value = define.child_by_field_name("value")
+    if defined is None or compact(text(defined, data)) != name:
+        return None
+    if value is not None and compact(text(value, data)) not in ("", "1"):
+        return None
+    return define.id

@@ -1,0 +1,265 @@
+"""Charts of real series and comparisons: measured by the real pipeline on real git repositories,
+rendered to PNG and SVG, decoded and read back."""
+
+from __future__ import annotations
+
+import threading
+import xml.etree.ElementTree as ET
+from io import BytesIO
+from pathlib import Path
+from xml.sax.saxutils import unescape
+
+import pytest
+from matplotlib.image import imread
+
+from archmetrics.app.series import run_compare
+from archmetrics.reports.charts import (
+    THESIS_FIGURES,
+    ChartError,
+    chart_kinds,
+    chart_of,
+    render_all,
+    render_compare_chart,
+    render_series_chart,
+    series_name,
+)
+from archmetrics.reports.charts_data import LOCATIONS
+from archmetrics.reports.charts_layout import APPROACH_COLOURS, LOCATION_COLOURS
+from archmetrics.reports.model import CompareReport, SeriesReport
+from tests.reports.study_repos import (
+    APPROACHES,
+    STAGES,
+    build_repo,
+    build_study,
+    p2p,
+    player,
+    series_request,
+)
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+KINDS = (
+    "coupling",
+    "scaled_changes",
+    "scaled_complexity",
+    "cost",
+    "coupling_total",
+    "scaled_changes_total",
+    "scaled_complexity_total",
+    "cost_total",
+)
+BY_LOCATION = {"scaled_changes": "scaled_changes", "scaled_complexity": "scaled_delta_vg",
+               "cost": "cost"}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory: pytest.TempPathFactory) -> CompareReport:
+    return build_study(tmp_path_factory.mktemp("study"))
+
+
+@pytest.fixture(scope="module")
+def pngs(study: CompareReport) -> dict[str, bytes]:
+    return render_all(study, "png")
+
+
+@pytest.fixture(scope="module")
+def svgs(study: CompareReport) -> dict[str, bytes]:
+    return render_all(study, "svg")
+
+
+def svg_texts(svg: bytes) -> list[str]:
+    """The SVG's texts: matplotlib draws glyphs as paths and writes each string in a comment."""
+    builder = ET.TreeBuilder(insert_comments=True)
+    parser = ET.XMLParser(target=builder)
+    parser.feed(svg)
+    root = parser.close()
+    assert root.tag == "{http://www.w3.org/2000/svg}svg"
+    comments = (e for e in root.iter() if not isinstance(e.tag, str))
+    return [unescape(str(e.text)).strip() for e in comments]  # matplotlib escapes <, >, &
+
+
+def decode_png(png: bytes) -> object:
+    assert png.startswith(PNG_SIGNATURE)
+    return imread(BytesIO(png), format="png")
+
+
+def has_colour(image: object, hex_colour: str) -> bool:
+    """Some pixel of the decoded RGBA image is (within rounding) the given colour."""
+    import numpy as np
+
+    rgb = np.array([int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5)])
+    pixels = np.asarray(image)[..., :3]
+    return bool((np.abs(pixels - rgb).max(axis=-1) < 2 / 255).any())
+
+
+def test_the_kinds_and_the_thesis_figures_they_reproduce() -> None:
+    assert chart_kinds() == KINDS
+    assert set(THESIS_FIGURES) == set(KINDS)
+    assert "7.1" in THESIS_FIGURES["coupling"] and "8.4" in THESIS_FIGURES["cost_total"]
+
+
+def test_the_pipeline_measured_three_approaches_of_three_stages(study: CompareReport) -> None:
+    assert [name for name, _ in study.series] == list(APPROACHES)
+    assert all(tuple(s.label for s in series.stages) == STAGES for _, series in study.series)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_png_decodes_to_a_drawn_image_of_the_chart_size(
+    kind: str, study: CompareReport, pngs: dict[str, bytes]
+) -> None:
+    import numpy as np
+
+    image = np.asarray(decode_png(pngs[kind]))
+    width, height = chart_of(study, kind).size
+    assert image.shape == (round(height * 100), round(width * 100), 4)
+    assert image[..., :3].std() > 0.05  # not blank
+    if kind != "coupling":
+        assert image.shape[:2] == (600, 1000)  # 10 x 6 in at 100 dpi
+    colours = APPROACH_COLOURS[: len(APPROACHES)] if kind.endswith("_total") else (
+        LOCATION_COLOURS[loc] for loc in LOCATIONS
+    )  # fmt: skip
+    for colour in colours:
+        assert has_colour(image, colour), f"{kind}: no bar drawn in {colour}"
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_svg_is_xml_with_title_stages_and_legend(kind: str, svgs: dict[str, bytes]) -> None:
+    texts = svg_texts(svgs[kind])
+    title = next(t for t in texts if t.endswith(": SOA, Player, P2P"))
+    assert title
+    for stage in STAGES:  # a tick label, or part of a panel title ("SOA · first")
+        assert any(t == stage or t.endswith(f" · {stage}") for t in texts)
+    legend = list(APPROACHES) if kind.endswith("_total") else list(LOCATIONS)
+    assert texts[-len(legend) :] == legend  # the legend is drawn last
+    if kind in ("coupling", "scaled_changes", "scaled_complexity", "cost"):
+        assert set(APPROACHES) <= {t.split(" · ")[0] for t in texts}  # one panel per approach
+
+
+def test_svg_and_png_carry_the_plain_title(svgs: dict[str, bytes], pngs: dict[str, bytes]) -> None:
+    title = ET.fromstring(svgs["scaled_complexity"]).find("{http://www.w3.org/2000/svg}title")
+    expected = "Scaled complexity change ΔVg' by location: SOA, Player, P2P"
+    assert title is not None and title.text == expected
+    assert expected.encode() in pngs["scaled_complexity"]  # an iTXt chunk, UTF-8
+
+
+def test_axis_labels_carry_the_thesis_symbols(svgs: dict[str, bytes]) -> None:
+    assert r"$\Gamma'$  scaled code size change" in svg_texts(svgs["scaled_changes"])
+    assert r"$\Delta V_g'$  scaled complexity change" in svg_texts(svgs["scaled_complexity"])
+    assert r"$E_{tot}$  complexity change cost" in svg_texts(svgs["cost_total"])
+    coupling = svg_texts(svgs["coupling"])
+    assert {r"$\Delta s_a$", r"$\Delta s_e$", r"$\Delta d_a$", r"$\Delta d_e$"} <= set(coupling)
+
+
+def test_bars_are_the_measured_values(study: CompareReport) -> None:
+    for kind, field in BY_LOCATION.items():
+        chart = chart_of(study, kind)
+        for (name, series), panel in zip(study.series, chart.panels, strict=True):
+            assert panel.title == name
+            for bars in panel.bars:
+                measured = [getattr(s.report.summaries()[bars.label], field) for s in series.stages]
+                assert [v.number for v in bars.values] == pytest.approx(measured)
+    p2p = chart_of(study, "coupling_total").panels[3].bars[2]  # Δd_e,tot of P2P
+    assert [v.number for v in p2p.values] == [s.report.change.total.delta_d_e
+                                              for s in study.series[2][1].stages]  # fmt: skip
+
+
+def test_baseline_conventions_are_marked_and_footnoted(svgs: dict[str, bytes]) -> None:
+    texts = svg_texts(svgs["scaled_changes"])
+    assert any(t.startswith("† λ̂ undefined: λ_pre = 0") for t in texts)
+    assert any(t.endswith("†") for t in texts)  # a baseline bar's value label
+
+
+def test_output_is_deterministic(study: CompareReport, svgs: dict[str, bytes]) -> None:
+    assert render_compare_chart(study, "cost", "svg") == svgs["cost"]
+    assert render_compare_chart(study, "cost", "png") == render_compare_chart(study, "cost")
+
+
+def test_concurrent_renders_give_the_same_bytes(
+    study: CompareReport, svgs: dict[str, bytes]
+) -> None:
+    results: dict[str, bytes] = {}
+
+    def render(kind: str) -> None:
+        results[kind] = render_compare_chart(study, kind, "svg")
+
+    threads = [threading.Thread(target=render, args=(k,)) for k in ("cost", "cost_total")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert results == {"cost": svgs["cost"], "cost_total": svgs["cost_total"]}
+
+
+def test_a_series_is_a_comparison_of_one(study: CompareReport) -> None:
+    series = study.series[1][1]
+    alone = CompareReport(((series_name(series), series),))
+    assert series_name(series) == "player"
+    svg = render_series_chart(series, "scaled_complexity", "svg")
+    assert svg == render_compare_chart(alone, "scaled_complexity", "svg")
+    texts = svg_texts(svg)
+    assert any(t.endswith("by location: player") for t in texts)
+    assert decode_png(render_series_chart(series, "coupling")) is not None
+
+
+@pytest.fixture(scope="module")
+def uneven(tmp_path_factory: pytest.TempPathFactory) -> CompareReport:
+    """Player in three stages, the last removing an operation; P2P stopped after two."""
+    folder = tmp_path_factory.mktemp("uneven")
+    repo = build_repo(folder / "player", player)
+    repo.commit("shrink", tag="shrunk", files=player(["query"]))
+    build_repo(folder / "p2p", p2p)
+    return run_compare(
+        [
+            ("Player", series_request(folder / "player", ("baseline", "first", "shrunk"), STAGES)),
+            ("P2P", series_request(folder / "p2p", STAGES[:2])),
+        ]
+    )
+
+
+def test_undefined_values_are_gaps_not_zeros(uneven: CompareReport) -> None:
+    chart = chart_of(uneven, "cost_total")
+    p2p = chart.panels[0].bars[1]
+    assert [v.number is None for v in p2p.values] == [False, False, True]
+    assert p2p.values[2].gap == "P2P has no stage 'second'"
+    texts = svg_texts(render_compare_chart(uneven, "cost_total", "svg"))
+    assert "n/a" in texts
+    assert any("n/a  undefined, not drawn (not zero): P2P has no stage 'second'" in t
+               for t in texts)  # fmt: skip
+    image = decode_png(render_compare_chart(uneven, "cost_total", "png"))
+    assert has_colour(image, APPROACH_COLOURS[1])  # P2P's defined stages are still drawn
+
+
+def test_negative_cost_is_drawn_below_zero_and_footnoted(uneven: CompareReport) -> None:
+    player_second = uneven.series[0][1].stages[2].report.change.total
+    assert player_second.scaled_delta_vg < 0 < player_second.scaled_changes
+    chart = chart_of(uneven, "cost_total")
+    value = chart.panels[0].bars[0].values[2]
+    assert value.number is not None and value.number < 0
+    assert value.number == pytest.approx(player_second.cost)
+    texts = svg_texts(render_compare_chart(uneven, "cost_total", "svg"))
+    assert any(" E < 0: ΔVg' < 0 so E < 0" in t for t in texts)
+
+
+def test_unknown_kind_format_or_empty_report_is_refused(study: CompareReport) -> None:
+    with pytest.raises(ChartError, match="unknown chart kind 'pie'"):
+        render_compare_chart(study, "pie")
+    with pytest.raises(ChartError, match="unknown chart format 'gif'"):
+        render_compare_chart(study, "cost", "gif")
+    with pytest.raises(ChartError, match="no stages"):
+        render_compare_chart(CompareReport(()), "cost")
+    with pytest.raises(ChartError, match="no stages"):
+        render_series_chart(SeriesReport("x", ()), "cost")
+
+
+def test_render_all_names_a_file_per_kind(tmp_path: Path, pngs: dict[str, bytes]) -> None:
+    assert tuple(pngs) == KINDS
+    for stem, data in pngs.items():
+        (tmp_path / f"{stem}.png").write_bytes(data)
+    assert sorted(p.stem for p in tmp_path.iterdir()) == sorted(KINDS)
+
+
+def test_names_are_shown_as_typed_not_as_mathtext(study: CompareReport) -> None:
+    renamed = CompareReport((("cost $x$ 1", study.series[0][1]), ("$", study.series[1][1])))
+    texts = svg_texts(render_compare_chart(renamed, "cost_total", "svg"))
+    assert texts[-2:] == ["cost $x$ 1", "$"]  # the legend: escaped, so drawn literally
+    assert "Complexity change cost across stages: cost $x$ 1, $" in texts
+    assert decode_png(render_compare_chart(renamed, "scaled_changes")) is not None
