@@ -1,0 +1,90 @@
+"""The rule table: data rows for ``archmetrics rules`` and the Markdown table in the docs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from archmetrics.coupling.rules import EndpointSource, EndpointSpec, Rule, RuleSet
+
+
+@dataclass(frozen=True, slots=True)
+class RuleRow:
+    """One rule as a row of text cells."""
+
+    pack: str
+    rule: str
+    language: str
+    match: str
+    kind: str
+    role: str
+    endpoint: str
+    requires: str = ""
+    priority: int = 0
+
+
+def describe_endpoint(spec: EndpointSpec | None) -> str:
+    """Where a rule reads its endpoint, in a few words (``service: arg 0 / service=``)."""
+    if spec is None:
+        return "-"
+    if spec.source is EndpointSource.CALLEE:
+        return f"{spec.type}: callee ~ {spec.pattern}"
+    places = []
+    if spec.arg is not None:
+        places.append(f"arg {spec.arg}")
+    if spec.keyword is not None:
+        places.append(f"{spec.keyword}=")
+    if spec.pattern is not None:
+        places.append(f"~ {spec.pattern}")
+    hints = ", ".join(
+        f"{h.match}({f'arg {h.arg}' if h.arg is not None else f'{h.keyword}='})"
+        for h in spec.same_function
+    )
+    if hints:
+        places.append(f"{'else ' if places else ''}same function: {hints}")
+    if spec.same_file:
+        places.append(f"{'else ' if places else ''}same file")
+    return f"{spec.type}: {' / '.join(places)}" if places else spec.type
+
+
+def rule_row(rule: Rule) -> RuleRow:
+    """A rule as text cells."""
+    match = ", ".join(rule.match) + (" (definition)" if rule.site.value == "definition" else "")
+    return RuleRow(
+        pack=rule.pack,
+        rule=rule.id,
+        language=", ".join(rule.languages),
+        match=match,
+        kind=rule.kind.value,
+        role=rule.role.value,
+        endpoint=describe_endpoint(rule.endpoint),
+        requires=", ".join(rule.requires),
+        priority=rule.priority,
+    )
+
+
+def rule_rows(rules: RuleSet) -> tuple[RuleRow, ...]:
+    """Every rule in force, in load order: the rows of ``archmetrics rules``."""
+    return tuple(rule_row(rule) for rule in rules.rules)
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ") or "-"
+
+
+def _code(text: str) -> str:
+    return f"`{_cell(text)}`" if text not in ("", "-") else "-"
+
+
+def rules_markdown(rules: RuleSet) -> str:
+    """The rule packs as Markdown: one section per pack, one table row per rule."""
+    lines: list[str] = []
+    header = "| rule | language | match | kind | role | endpoint | requires |"
+    for pack in rules.packs:
+        lines += [f"### `{pack.name}`", "", pack.description, "", header,
+                  "|---|---|---|---|---|---|---|"]  # fmt: skip
+        for row in (rule_row(rule) for rule in pack.rules):
+            cells = (row.rule, row.language, row.match, row.kind, row.role, row.endpoint,
+                     row.requires)  # fmt: skip
+            lines.append("| " + " | ".join(_code(c) for c in cells) + " |")
+        lines.append("")
+    return "\n".join(lines)

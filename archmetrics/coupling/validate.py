@@ -1,0 +1,212 @@
+"""Validating a decoded rule pack: every key checked up front, errors name file, rule and key."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import NoReturn
+
+from archmetrics.coupling.rules import (
+    ENDPOINT_TYPES,
+    KNOWN_LANGUAGES,
+    EndpointSource,
+    EndpointSpec,
+    FunctionHint,
+    LinkKind,
+    Role,
+    Rule,
+    RulePack,
+    RulePackError,
+    SiteKind,
+)
+
+_PACK_KEYS = frozenset({"name", "description"})
+_RULE_KEYS = frozenset(
+    {"id", "language", "match", "kind", "role", "site", "requires", "priority", "endpoint",
+     "description", "example", "example_endpoint"}
+)  # fmt: skip
+_ENDPOINT_KEYS = frozenset(
+    {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file"}
+)
+_HINT_KEYS = frozenset({"match", "arg", "keyword"})
+_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
+
+
+@dataclass(frozen=True, slots=True)
+class _Where:
+    source: str
+    rule: str | None = None
+
+    def fail(self, key: str | None, problem: str) -> NoReturn:
+        raise RulePackError(self.source, self.rule, key, problem)
+
+    def table(self, value: object, key: str, allowed: frozenset[str]) -> Mapping[str, object]:
+        if not isinstance(value, Mapping):
+            self.fail(key, f"must be a table, got {type(value).__name__}")
+        for name in value:
+            if name not in allowed:
+                known = _list(allowed)
+                self.fail(f"{key}.{name}" if key else name, f"unknown key (known: {known})")
+        return value
+
+    def text(self, table: Mapping[str, object], key: str, default: str | None = None) -> str:
+        value = table.get(key, default)
+        if not isinstance(value, str) or (default is None and not value):
+            self.fail(key, "required non-empty string" if value is None else "must be a string")
+        return value
+
+    def texts(self, table: Mapping[str, object], key: str, required: bool) -> tuple[str, ...]:
+        value = table.get(key, [] if not required else None)
+        items = [value] if isinstance(value, str) else value
+        if not isinstance(items, list) or not all(isinstance(i, str) and i for i in items):
+            self.fail(key, "must be a string or a list of non-empty strings")
+        if required and not items:
+            self.fail(key, "must not be empty")
+        return tuple(str(i) for i in items)
+
+    def integer(self, table: Mapping[str, object], key: str) -> int | None:
+        value = table.get(key)
+        if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
+            self.fail(key, f"must be an integer, got {value!r}")
+        if isinstance(value, int) and key == "arg" and value < 0:
+            self.fail(key, "argument index must be >= 0")
+        return value
+
+    def choice(self, table: Mapping[str, object], key: str, allowed: frozenset[str],
+               default: str | None = None) -> str:  # fmt: skip
+        value = self.text(table, key, default)
+        if value not in allowed:
+            self.fail(key, f"{value!r} is not one of {_list(allowed)}")
+        return value
+
+
+def _list(values: frozenset[str]) -> str:
+    return ", ".join(sorted(values))
+
+
+def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
+    """Validate one decoded TOML document and build its :class:`RulePack`."""
+    top = _Where(source)
+    top.table(data, "", frozenset({"pack", "rules"}))
+    pack = top.table(data.get("pack"), "pack", _PACK_KEYS)
+    name = top.text(pack, "name")
+    if not _ID.match(name):
+        top.fail("pack.name", f"{name!r} must be letters, digits and _.+-")
+    raw_rules = data.get("rules")
+    if not isinstance(raw_rules, list) or not raw_rules:
+        top.fail("rules", "a pack needs a non-empty [[rules]] array")
+    rules = tuple(_parse_rule(raw, name, source, index) for index, raw in enumerate(raw_rules))
+    seen: set[str] = set()
+    for rule in rules:
+        if rule.id in seen:
+            _Where(source, rule.id).fail("id", "duplicate rule id in this pack")
+        seen.add(rule.id)
+    return RulePack(name, source, top.text(pack, "description", ""), rules)
+
+
+def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
+    rule_id = raw.get("id") if isinstance(raw, Mapping) else None
+    where = _Where(source, rule_id if isinstance(rule_id, str) else f"#{index + 1}")
+    table = where.table(raw, "", _RULE_KEYS)
+    ident = where.text(table, "id")
+    if not _ID.match(ident):
+        where.fail("id", f"{ident!r} must be letters, digits and _.+-")
+    languages = where.texts(table, "language", required=True)
+    for language in languages:
+        if language not in KNOWN_LANGUAGES:
+            where.fail("language", f"{language!r} is not one of {_list(KNOWN_LANGUAGES)}")
+    endpoint = table.get("endpoint")
+    example_endpoint = table.get("example_endpoint")
+    if example_endpoint is not None and not isinstance(example_endpoint, str):
+        where.fail("example_endpoint", "must be a string")
+    return Rule(
+        pack=pack,
+        id=ident,
+        languages=languages,
+        match=_patterns(where, table),
+        kind=LinkKind(where.choice(table, "kind", frozenset(LinkKind))),
+        role=Role(where.choice(table, "role", frozenset(Role))),
+        site=SiteKind(where.choice(table, "site", frozenset(SiteKind), SiteKind.CALL)),
+        requires=where.texts(table, "requires", required=False),
+        priority=where.integer(table, "priority") or 0,
+        endpoint=None if endpoint is None else _parse_endpoint(where, endpoint),
+        description=where.text(table, "description", ""),
+        examples=_examples(where, table.get("example"), languages),
+        example_endpoint=example_endpoint,
+    )
+
+
+def _examples(
+    where: _Where, raw: object, languages: tuple[str, ...]
+) -> tuple[tuple[str, str], ...]:
+    """``example = "..."`` (in the rule's first language) or ``[rules.example]`` by language."""
+    if raw is None:
+        return ()
+    if isinstance(raw, str):
+        return ((languages[0], raw),)
+    table = where.table(raw, "example", frozenset(languages))
+    if not all(isinstance(text, str) for text in table.values()):
+        where.fail("example", "examples must be strings")
+    return tuple((language, str(text)) for language, text in table.items())
+
+
+def _patterns(where: _Where, table: Mapping[str, object]) -> tuple[str, ...]:
+    patterns = where.texts(table, "match", required=True)
+    for pattern in patterns:
+        if any(c.isspace() for c in pattern) or "(" in pattern:
+            where.fail("match", f"{pattern!r}: a pattern is a dotted callee name with * globs")
+    return patterns
+
+
+def _parse_endpoint(where: _Where, raw: object) -> EndpointSpec:
+    table = where.table(raw, "endpoint", _ENDPOINT_KEYS)
+    try:
+        spec = _endpoint_fields(where, table)
+    except RulePackError as error:
+        key = error.key or ""
+        key = key if key.startswith("endpoint") else f"endpoint.{key}"
+        raise RulePackError(error.source, error.rule, key, error.problem) from None
+    if spec.source is EndpointSource.CALLEE and spec.pattern is None:
+        where.fail("endpoint.pattern", "an endpoint taken from the callee needs a pattern")
+    return spec
+
+
+def _endpoint_fields(where: _Where, table: Mapping[str, object]) -> EndpointSpec:
+    pattern = table.get("pattern")
+    if pattern is not None:
+        if not isinstance(pattern, str):
+            where.fail("pattern", "must be a string")
+        try:
+            re.compile(pattern)
+        except re.error as error:
+            where.fail("pattern", f"bad regular expression: {error}")
+    hints = table.get("same_function", [])
+    if not isinstance(hints, list):
+        where.fail("same_function", "must be an array of tables")
+    source = where.choice(table, "from", frozenset(EndpointSource), EndpointSource.ARGUMENT)
+    same_file = table.get("same_file", False)
+    if not isinstance(same_file, bool):
+        where.fail("same_file", "must be true or false")
+    return EndpointSpec(
+        type=where.choice(table, "type", ENDPOINT_TYPES),
+        arg=where.integer(table, "arg"),
+        keyword=where.text(table, "keyword", "") or None,
+        source=EndpointSource(source),
+        pattern=pattern,
+        same_function=tuple(_parse_hint(where, hint) for hint in hints),
+        same_file=same_file,
+    )
+
+
+def _parse_hint(where: _Where, raw: object) -> FunctionHint:
+    table = where.table(raw, "endpoint.same_function", _HINT_KEYS)
+    try:
+        match = where.text(table, "match")
+        arg, keyword = where.integer(table, "arg"), where.text(table, "keyword", "") or None
+    except RulePackError as error:
+        key = f"endpoint.same_function.{error.key}"
+        raise RulePackError(error.source, error.rule, key, error.problem) from None
+    if arg is None and keyword is None:
+        where.fail("endpoint.same_function", "a hint needs arg or keyword")
+    return FunctionHint(match, arg, keyword)

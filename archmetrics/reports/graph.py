@@ -1,0 +1,107 @@
+"""The element graph as Graphviz dot, Mermaid or JSON: pure functions returning text.
+
+Static edges are solid and labelled with the dependency (``common.h``, ``pkg.mod``); dynamic
+edges are dashed and labelled with their endpoint (``topic:pose``), with ``x2`` when more
+than one link site makes the edge. JSON is versioned: ``"schema": "archmetrics.graph/1"``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping
+from enum import StrEnum
+from pathlib import PurePosixPath
+
+from archmetrics.coupling.elements import Element
+from archmetrics.coupling.model import EdgeKind, ElementGraph, GraphEdge
+
+SCHEMA = "archmetrics.graph/1"
+
+
+class GraphFormat(StrEnum):
+    DOT = "dot"
+    MERMAID = "mermaid"
+    JSON = "json"
+
+
+def node_label(element: Element) -> str:
+    """The element's name, with its file names when the name does not say them."""
+    if element.files == (element.name,):
+        return element.name
+    return f"{element.name} ({', '.join(PurePosixPath(f).name for f in element.files)})"
+
+
+def edge_label(edge: GraphEdge) -> str:
+    """The dependency or endpoint, with the number of sites when there are several."""
+    return edge.label if edge.weight == 1 else f"{edge.label} x{edge.weight}"
+
+
+def _dot_text(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def render_dot(graph: ElementGraph) -> str:
+    """Graphviz dot: boxes for elements, solid static and dashed dynamic edges."""
+    lines = ["digraph coupling {", "  rankdir=LR;", "  node [shape=box];"]
+    for node in graph.nodes:
+        lines.append(f"  {_dot_text(node.name)} [label={_dot_text(node_label(node))}];")
+    for edge in graph.edges:
+        style = "solid" if edge.kind is EdgeKind.STATIC else "dashed"
+        lines.append(
+            f"  {_dot_text(edge.source)} -> {_dot_text(edge.target)}"
+            f" [label={_dot_text(edge_label(edge))}, style={style}];"
+        )
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def _mermaid_text(text: str) -> str:
+    return '"' + text.replace('"', "#quot;") + '"'
+
+
+def render_mermaid(graph: ElementGraph) -> str:
+    """A Mermaid flowchart: ``-->`` for static edges, ``-.->`` for dynamic ones."""
+    ids = {node.name: f"n{index}" for index, node in enumerate(graph.nodes)}
+    lines = ["flowchart LR"]
+    for node in graph.nodes:
+        lines.append(f"  {ids[node.name]}[{_mermaid_text(node_label(node))}]")
+    for edge in graph.edges:
+        arrow = "-->" if edge.kind is EdgeKind.STATIC else "-.->"
+        label = _mermaid_text(edge_label(edge))
+        lines.append(f"  {ids[edge.source]} {arrow}|{label}| {ids[edge.target]}")
+    return "\n".join(lines) + "\n"
+
+
+def render_json(graph: ElementGraph) -> str:
+    """The graph as versioned JSON (schema ``archmetrics.graph/1``)."""
+    document = {
+        "schema": SCHEMA,
+        "nodes": [
+            {"name": n.name, "files": list(n.files), "languages": list(n.languages)}
+            for n in graph.nodes
+        ],
+        "edges": [
+            {
+                "source": e.source,
+                "target": e.target,
+                "kind": e.kind.value,
+                "label": e.label,
+                "weight": e.weight,
+            }
+            for e in graph.edges
+        ],
+    }
+    return json.dumps(document, indent=2) + "\n"
+
+
+RENDERERS: Mapping[GraphFormat, Callable[[ElementGraph], str]] = {
+    GraphFormat.DOT: render_dot,
+    GraphFormat.MERMAID: render_mermaid,
+    GraphFormat.JSON: render_json,
+}
+assert set(RENDERERS) == set(GraphFormat), "every graph format needs a renderer"
+
+
+def render(graph: ElementGraph, format: GraphFormat | str) -> str:
+    """Render ``graph`` in ``format`` (``dot``, ``mermaid`` or ``json``)."""
+    return RENDERERS[GraphFormat(format)](graph)
