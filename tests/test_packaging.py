@@ -1,4 +1,4 @@
-"""The built wheel carries everything a plain `pip install` user needs, and replicate runs from it."""
+"""The wheel carries what a plain `pip install` user needs; replicate runs from it."""
 
 from __future__ import annotations
 

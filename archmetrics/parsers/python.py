@@ -1,0 +1,76 @@
+"""Python parser: source text in, :class:`FileFacts` out, via one libcst parse and one pass.
+
+The rules (what is a logical line, what is a decision point) are in docs/metrics.md and in
+python_rules.py; the pass itself is python_walk.py. Bad input never raises: a file libcst
+cannot parse is reported with a warning naming the line, and nothing is guessed from it.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import warnings
+
+import libcst as cst
+
+from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
+from archmetrics.parsers.python_walk import FactsWalker
+
+_ERROR_AT = re.compile(r"error at (\d+):(\d+)")
+_ERROR_PREFIX = re.compile(r"^(?:parser|tokenizer) error: (?:error at \d+:\d+: )?")
+
+
+def parse(path: str, source: str) -> FileFacts:
+    """Facts of one Python file (``generated`` is left to the registry)."""
+    if "\r" in source:  # Python reads \r\n and lone \r as newlines; so do we
+        source = source.replace("\r\n", "\n").replace("\r", "\n")
+    try:
+        module = cst.parse_module(source)
+    except cst.ParserSyntaxError as error:
+        message = _ERROR_PREFIX.sub("", error.message)
+        return _unparsed(path, _error_line(error, source), f"Python syntax error: {message}")
+    except RecursionError:
+        return _unparsed(path, 1, "Python source nested too deeply to parse")
+    except Exception as error:  # the native parser's own failures on odd input
+        return _unparsed(path, 1, f"Python parser failed: {type(error).__name__}: {error}")
+    walker = FactsWalker()
+    try:
+        module._codegen(walker)
+    except RecursionError:
+        return _unparsed(path, 1, "Python source nested too deeply to measure")
+    return FileFacts(
+        path=path,
+        language=Language.PYTHON,
+        statements=tuple(walker.statements),
+        functions=tuple(f for f in walker.functions if f is not None),
+        classes=tuple(c for c in walker.classes if c is not None),
+        dependencies=tuple(walker.dependencies),
+        call_sites=tuple(c for c in walker.calls if c is not None),
+        sloc=walker.sloc(source),
+    )
+
+
+def _unparsed(path: str, line: int, message: str) -> FileFacts:
+    warning = ParseWarning(path, line, message, Severity.ERROR)
+    return FileFacts(path=path, language=Language.PYTHON, parsed=False, warnings=(warning,))
+
+
+def _error_line(error: cst.ParserSyntaxError, source: str) -> int:
+    """The line of a syntax error as CPython reports it (libcst's own lines can be off by one).
+
+    Only paid for on failure: CPython's parser is asked where the error is; if it accepts the
+    source, libcst's position stands.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ast.parse(source)
+    except SyntaxError as python_error:
+        line = python_error.lineno or 1
+    except (ValueError, RecursionError, MemoryError):
+        line = error.raw_line
+    else:
+        found = _ERROR_AT.search(error.message)
+        line = int(found.group(1)) if found else error.raw_line
+    last = source.count("\n") + (0 if source.endswith("\n") else 1)
+    return max(1, min(line, last))

@@ -1,0 +1,68 @@
+"""Call sites: callee, receiver and arguments of one ``Call``, read from the token stream.
+
+The call's own parentheses are found by position: a call's tokens are its ``lpar``s, the
+callee, ``(``, the arguments, ``)`` and its ``rpar``s, and each argument's first token is
+known from the walk. Only inside an f-string, where tokens are glued, is text regenerated.
+"""
+
+from __future__ import annotations
+
+import libcst as cst
+
+from archmetrics.facts import Argument
+from archmetrics.parsers import python_rules as rules
+from archmetrics.parsers.python_tokens import TokenState, normalized
+
+CallParts = tuple[str, str | None, tuple[Argument, ...]]  # callee, receiver, arguments
+
+
+def from_tokens(
+    state: TokenState, node: cst.Call, first: int, end: int, starts: list[int]
+) -> CallParts:
+    """Callee, receiver and arguments of a call spanning tokens ``first:end``.
+
+    ``starts`` holds the first token index of each argument.
+    """
+    close = end - len(node.rpar) - 1  # the call's own ")"
+    open_ = (starts[0] if starts else close) - 1  # the call's own "("
+    func = node.func
+    callee = rules.dotted(func) or state.text(first + len(node.lpar), open_)
+    receiver = None
+    if isinstance(func, cst.Attribute):
+        receiver = rules.dotted(func.value)
+        if receiver is None and not func.lpar:  # drop "." and the attribute name
+            receiver = state.text(first + len(node.lpar), open_ - 2)
+        elif receiver is None:
+            receiver = normalized(func.value)
+    ends = [*starts[1:], close] if starts else []
+    arguments = tuple(
+        _argument(state, arg, a, b) for arg, a, b in zip(node.args, starts, ends, strict=True)
+    )
+    return callee, receiver, arguments
+
+
+def _argument(state: TokenState, arg: cst.Arg, first: int, end: int) -> Argument:
+    if end > first and state.toks[end - 1] == ",":
+        end -= 1
+    if arg.keyword is not None:
+        first += 2  # keyword and "="
+    is_literal, value = rules.literal(arg.value) if not arg.star else (False, None)
+    keyword = arg.keyword.value if arg.keyword is not None else None
+    return Argument(state.text(first, end), value, is_literal, keyword)
+
+
+def from_nodes(node: cst.Call) -> CallParts:
+    """Callee, receiver and arguments of a call whose tokens cannot be sliced."""
+    func = node.func
+    callee = rules.dotted(func) or normalized(func)
+    receiver = None
+    if isinstance(func, cst.Attribute):
+        receiver = rules.dotted(func.value) or normalized(func.value)
+    arguments = []
+    for arg in node.args:
+        text = normalized(arg.value)
+        is_literal, value = rules.literal(arg.value) if not arg.star else (False, None)
+        keyword = arg.keyword.value if arg.keyword is not None else None
+        shown = f"{arg.star} {text}" if arg.star else text
+        arguments.append(Argument(shown, value, is_literal, keyword))
+    return callee, receiver, tuple(arguments)

@@ -1,0 +1,136 @@
+"""Token stream of a libcst tree: significant tokens with their lines, comments dropped.
+
+libcst keeps no positions on its nodes; its own ``PositionProvider`` regenerates the code and
+records a range for every node, which costs more than the parse. We ride the same code
+generation (``CSTNode._codegen`` with a custom ``CodegenState``, the mechanism libcst's
+position providers use) but keep only what the metrics need: each significant token, the
+line it starts on and the line it ends on. Any node's span and normalized text are then a
+slice of these lists, taken between the node's ``before_codegen`` and ``after_codegen``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager, nullcontext
+from typing import Any
+
+import libcst as cst
+from libcst._nodes.internal import CodegenState
+
+_BLANK = " \t\f\v\\\r\n"  # whitespace tokens, line continuations included
+_NULL_CONTEXT: AbstractContextManager[None] = nullcontext()
+
+Hook = Callable[[Any, Any], None]  # (state, node): an unbound method of a subclass
+
+
+class TokenState(CodegenState):
+    """Collects significant tokens while libcst generates code.
+
+    ``toks[i]`` is the i-th significant token, ``starts[i]``/``ends[i]`` its first and last
+    line. Comments never enter the list. An f-string is glued into one token (its literal
+    text is not to be re-spaced). Subclasses observe nodes through ``enter``/``leave`` tables.
+    """
+
+    enter: Mapping[type[cst.CSTNode], Hook] = {}
+    leave: Mapping[type[cst.CSTNode], Hook] = {}
+
+    def __init__(self) -> None:
+        super().__init__(default_indent="    ", default_newline="\n")
+        self.line = 1
+        self.toks: list[str] = []
+        self.starts: list[int] = []
+        self.ends: list[int] = []
+        self.fstring_depth = 0
+        self.fstring_fresh = False
+        self.skip_depth = 0  # > 0 inside a node whose tokens are not code (a docstring)
+        self.code_lines: set[int] = set()
+        self.multiline_code: list[tuple[int, int]] = []  # code tokens spanning lines
+
+    # -- CodegenState protocol -------------------------------------------------------------
+    def add_indent_tokens(self) -> None:
+        """Indentation is whitespace: nothing to record."""
+
+    def pop_trailing_newline(self) -> None:
+        """We keep no raw token list, so there is no trailing newline to drop."""
+
+    def add_token(self, value: str) -> None:
+        start = self.line
+        if "\n" in value:
+            self.line += value.count("\n")
+        if self.fstring_depth and not self.fstring_fresh:
+            self.toks[-1] += value
+            self.ends[-1] = self.line
+        elif value[:1] == "#" or not value.strip(_BLANK):
+            return  # a comment or whitespace
+        else:
+            self.fstring_fresh = False
+            self.toks.append(value)
+            self.starts.append(start)
+            self.ends.append(self.line)
+        if self.skip_depth:
+            return
+        if start == self.line:
+            self.code_lines.add(start)
+        else:
+            self.multiline_code.append((start, self.line))
+
+    def before_codegen(self, node: cst.CSTNode) -> None:
+        kind = type(node)
+        if kind is cst.FormattedString:
+            if not self.fstring_depth:
+                self.fstring_fresh = True
+            self.fstring_depth += 1
+        hook = self.enter.get(kind)
+        if hook is not None:
+            hook(self, node)
+
+    def after_codegen(self, node: cst.CSTNode) -> None:
+        kind = type(node)
+        hook = self.leave.get(kind)
+        if hook is not None:
+            hook(self, node)
+        if kind is cst.FormattedString:
+            self.fstring_depth -= 1
+
+    def record_syntactic_position(  # type: ignore[override]  # any context manager will do
+        self,
+        node: cst.CSTNode,
+        *,
+        start_node: cst.CSTNode | None = None,
+        end_node: cst.CSTNode | None = None,
+    ) -> AbstractContextManager[None]:
+        self.syntactic_start(node)
+        return _NULL_CONTEXT
+
+    def syntactic_start(self, node: cst.CSTNode) -> None:
+        """Called where a node's own syntax begins (after its comments and decorators)."""
+
+    # -- reading the stream -----------------------------------------------------------------
+    def text(self, first: int, last: int) -> str:
+        """Normalized text of tokens ``first:last``: joined by single spaces."""
+        return " ".join(self.toks[first:last])
+
+    def first_line(self, index: int) -> int:
+        """Line of token ``index`` (or of the last token when the node emitted none)."""
+        if index < len(self.starts):
+            return self.starts[index]
+        return self.ends[-1] if self.ends else 1
+
+    def last_line(self, end: int) -> int:
+        """Last line of the tokens before index ``end``."""
+        return self.ends[end - 1] if end > 0 else 1
+
+    def sloc(self, source: str) -> int:
+        """Lines holding code: those of one-line tokens, and non-blank lines of long tokens."""
+        counted = set(self.code_lines)
+        lines = source.split("\n") if self.multiline_code else []
+        for start, end in self.multiline_code:
+            counted.update(n for n in range(start, end + 1) if lines[n - 1].strip())
+        return len(counted)
+
+
+def normalized(node: cst.CSTNode) -> str:
+    """A node's normalized text on its own (tokens, comments dropped, single spaces)."""
+    state = TokenState()
+    node._codegen(state)
+    return state.text(0, len(state.toks))
