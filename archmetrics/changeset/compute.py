@@ -17,7 +17,7 @@
 Excluded files count nowhere and are listed with their reason: a side whose path matches an
 exclude glob or whose facts say ``generated`` is dropped alone; a pair with a side no parser
 could read is dropped whole. Every location appears in the report, empty
-or not; sums run over all elements of a location, changed or not (docs/_drafts/changeset.md).
+or not; sums run over all elements of a location, changed or not (docs/metrics.md).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 A page of arithmetic that reads like the thesis (Hestand 2011, pp. 101-107), equation numbers
 in comments. The open cases the thesis leaves (a scale with nothing before, negative ΔVg, ...)
-follow the conventions in docs/_drafts/changeset.md and are always flagged in ``notes`` as
+follow the conventions in docs/metrics.md and are always flagged in ``notes`` as
 ``"<code>: <human text>"`` so a convention is never mistaken for a measurement.
 """
 

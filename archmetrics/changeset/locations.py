@@ -1,6 +1,6 @@
 """Locations (thesis p. 73: base, new, framework) and the path globs that assign files to them.
 
-Glob semantics are gitignore-like (documented in docs/_drafts/changeset.md, tested in
+Glob semantics are gitignore-like (documented in docs/metrics.md, tested in
 tests/changeset/test_locations.py). Paths are POSIX, relative to the repository root.
 
 * ``*`` matches any run of characters except ``/``; ``?`` one character except ``/``;

@@ -3,7 +3,7 @@
 Field names are the JSON keys: a :class:`Summary` is one location's (or the total's) metrics
 S, an :class:`ElementChange` one element's change set with its pre/post metrics M. ``to_dict``
 gives plain JSON types: ints, floats, strings, lists, and None (``null``) where a value is
-undefined -- always with a note saying why (docs/_drafts/changeset.md, "Conventions").
+undefined -- always with a note saying why (docs/metrics.md, "Conventions").
 """
 
 from __future__ import annotations

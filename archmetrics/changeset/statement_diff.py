@@ -2,7 +2,7 @@
 
 Statements are the parser's logical lines of code (thesis p. 103) with normalized text, so
 reformatting, comment edits and splitting a statement over several lines change nothing here.
-The pairing rule (docs/_drafts/changeset.md, "Pairing rule"):
+The pairing rule (docs/metrics.md, "Pairing rule"):
 
 1. Align the pre and post sequences with ``difflib.SequenceMatcher(autojunk=False)`` over the
    keys ``(kind, text)``. ``equal`` runs are unchanged, ``delete`` runs removed, ``insert``

@@ -7,7 +7,7 @@ Entry points for the application layer:
 - :func:`measure_coupling` -- facts, options and rules to a :class:`CouplingReport`;
 - :func:`rule_rows` / :func:`rules_markdown` -- the rule table for ``archmetrics rules``.
 
-See docs/_drafts/coupling.md for the definitions and rules.
+See docs/metrics.md for the definitions and rules.
 """
 
 from __future__ import annotations

@@ -75,12 +75,12 @@ def _code(text: str) -> str:
     return f"`{_cell(text)}`" if text not in ("", "-") else "-"
 
 
-def rules_markdown(rules: RuleSet) -> str:
-    """The rule packs as Markdown: one section per pack, one table row per rule."""
+def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
+    """The rule packs as Markdown: one section per pack (``heading`` level), a row per rule."""
     lines: list[str] = []
     header = "| rule | language | match | kind | role | endpoint | requires |"
     for pack in rules.packs:
-        lines += [f"### `{pack.name}`", "", pack.description, "", header,
+        lines += [f"{heading} `{pack.name}`", "", pack.description, "", header,
                   "|---|---|---|---|---|---|---|"]  # fmt: skip
         for row in (rule_row(rule) for rule in pack.rules):
             cells = (row.rule, row.language, row.match, row.kind, row.role, row.endpoint,

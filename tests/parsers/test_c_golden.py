@@ -1,4 +1,4 @@
-"""Golden cases for the C parser: one per row of the λ table in docs/_drafts/c-rules.md."""
+"""Golden cases for the C parser: one per row of the λ table in docs/metrics.md."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 The corpus is pinned sdists from PyPI with substantial hand-written C and C++ (their vendored
 C libraries, their C++ extension sources), downloaded once into ARCHMETRICS_CORPUS_DIR
 (default <repo>/.cache/corpus). Functions are matched by (file, last line); where lizard and
-we differ on purpose, docs/_drafts/c-rules.md names the class and a golden test shows it.
+we differ on purpose, docs/metrics.md names the class and a golden test shows it.
 """
 
 from __future__ import annotations
@@ -125,7 +125,7 @@ _TRY_BLOCK = re.compile(r"\)\s*(const\s*)?try\s*\{")
 
 
 def _disagreement_class(source_lines: list[str], ours: Function, expected: int) -> str:
-    """Which documented class (docs/_drafts/c-rules.md) explains a v_g difference, if any."""
+    """Which documented class (docs/metrics.md) explains a v_g difference, if any."""
     body = "\n".join(source_lines[ours.span.start - 1 : ours.span.end])
     delta = ours.complexity - expected
     ifndef = sum(1 for d in ours.decisions if d.kind in _NOT_IN_LIZARD)

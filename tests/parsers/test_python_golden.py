@@ -1,4 +1,4 @@
-"""Golden cases for the Python parser: one per row of the tables in docs/_drafts/python-rules.md."""
+"""Golden cases for the Python parser: one per row of the tables in docs/metrics.md."""
 
 from __future__ import annotations
 

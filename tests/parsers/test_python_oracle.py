@@ -3,7 +3,7 @@
 The corpus is real Python nobody here wrote: the installed sources of rich, GitPython,
 libcst and part of pandas.core (about 400 files, deterministic selection). Functions are
 matched by (file, def line). The deliberate differences are listed in
-docs/_drafts/python-rules.md, each with a golden test; any disagreement printed here that is
+docs/metrics.md, each with a golden test; any disagreement printed here that is
 not one of them is a bug on one side.
 """
 
