@@ -67,6 +67,16 @@ def _under(path: str, prefixes: tuple[str, ...]) -> bool:
     return any(path == p or pure.is_relative_to(p) for p in prefixes)
 
 
+def _nothing_to_measure(request: ScanRequest, snapshot: Snapshot, prefixes: tuple[str, ...]) -> str:
+    if request.rev is not None and prefixes:
+        known = [f.path for f in snapshot.files()]
+        missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
+        if missing:
+            return f"{missing[0]}: no such path at revision {request.rev}"
+    where = ", ".join(prefixes) or "the tree"
+    return f"no source files to measure in {where} ({snapshot.label}); see 'languages' in docs"
+
+
 def run_scan(
     request: ScanRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> ScanReport:
@@ -75,11 +85,14 @@ def run_scan(
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
     selected = select(snapshot, table, lambda path: _under(path, prefixes))
-    if request.paths and not selected and request.rev is not None:
-        known = {f.path for f in snapshot.files()}
-        missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
-        if missing:
-            raise SourceError(f"{missing[0]}: no such path at revision {request.rev}")
+    if not selected and request.rev is None and prefixes and len(request.paths) == 1:
+        # a folder git ignores (a virtualenv, a build tree) is read as the plain folder it is
+        folder = request.paths[0].resolve()
+        if folder.is_dir():
+            root, snapshot, prefixes = folder, DirectorySnapshot(folder), ()
+            selected = select(snapshot, table)
+    if not selected:
+        raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
     jobs = request.jobs or request.settings.jobs
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache)
     metrics = tuple(file_metrics(f) for f in facts)

@@ -132,3 +132,18 @@ def test_bad_usage_is_exit_2_with_one_line(repo: GitRepo, argv: list[str], messa
     assert done.returncode == 2
     assert message in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+
+
+def test_an_ignored_folder_is_read_as_a_plain_folder(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    repo.commit("v1", files={".gitignore": "vendor/\n", "p.py": PY_V1})
+    repo.write({"vendor/lib/q.py": PY_V2})
+    files = _files(_json(capsys, "scan", str(repo.root / "vendor"), "--format", "json"))
+    assert list(files) == ["lib/q.py"]
+
+
+def test_nothing_to_measure_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "notes.txt").write_text("no source here\n")
+    assert main(["scan", str(tmp_path)]) == 2
+    assert "no source files to measure" in capsys.readouterr().err
