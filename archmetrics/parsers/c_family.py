@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import bisect
 import importlib
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -124,9 +125,26 @@ def parse(path: str, source: str, language: Language) -> FileFacts:
         )
 
 
+_CPLUSPLUS = rb"#[ \t]*if(?:def[ \t]+__cplusplus|[ \t]+defined[ \t(]*__cplusplus[ \t)]*)[^\n]*\n"
+_EXTERN_C_GUARD = re.compile(
+    rb"(" + _CPLUSPLUS + rb")([ \t]*(?:extern[ \t]+\"C\"[ \t]*)?[{}][ \t]*)(?=\n[ \t]*#[ \t]*endif)"
+)
+
+
+def hide_extern_c_guards(data: bytes) -> bytes:
+    """Blank the ``extern "C" {`` and ``}`` lines that sit alone inside ``#ifdef __cplusplus``.
+
+    The idiom opens a brace in one preprocessor branch and closes it in another, which no
+    grammar of the unpreprocessed text can follow (tree-sitter reports a missing ``#endif``).
+    Those lines count 0 anyway (an ``extern "C"`` block is not a statement); blanking them with
+    spaces keeps every byte offset and line number.
+    """
+    return _EXTERN_C_GUARD.sub(lambda m: m.group(1) + b" " * len(m.group(2)), data)
+
+
 def _parse(path: str, source: str, language: Language) -> FileFacts:
     built = grammar(language)
-    data = source.encode("utf-8", "surrogatepass")
+    data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
     root = built.parser.parse(data).root_node
     found = QueryCursor(built.query).captures(root)
     slots = _functions(found.get("stmt", []), data)

@@ -310,3 +310,22 @@ def test_declaration_in_a_while_condition_is_part_of_the_header() -> None:
         ("while", "while ( T * p = next ( ) )"),
         ("expression", "use ( p ) ;"),
     ]
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_extern_c_guard_idiom_parses_cleanly_and_counts_nothing(language: str) -> None:
+    source = """\
+        #ifndef API_H
+        #define API_H
+        #ifdef __cplusplus
+        extern "C" {
+        #endif
+        int api_open(const char *name);
+        #ifdef __cplusplus
+        }
+        #endif
+        #endif
+        """
+    facts = facts_of(source, language, "api.h")
+    assert facts.warnings == ()
+    assert [(s.kind, s.span.start) for s in facts.statements] == [("declaration", 6)]
