@@ -221,7 +221,8 @@ def file_link_sites(
     found: list[tuple[Rule, LinkSite]] = []
     for call in facts.call_sites:
         receiver = normalize_callee(call.receiver) if call.receiver else None
-        if rule := calls.choose(call.callee, receiver in modules):
+        rule = calls.choose(call.callee, receiver in modules)
+        if rule and not (rule.unless_from and _assigned_from(facts, call, rule.unless_from)):
             endpoint, note = read_endpoint(call, rule.endpoint, facts.call_sites, read)
             site = _site(facts.path, call.span.start, rule, call.callee, endpoint, call.function)
             found.append((rule, replace(site, note=note)))
@@ -233,6 +234,22 @@ def file_link_sites(
             found.append((rule, _site(facts.path, function.span.start, rule, name, endpoint, name)))
     sites = [_from_file(rule, site, found) for rule, site in found]
     return tuple(sorted(sites, key=lambda s: (s.line, s.rule)))
+
+
+def _assigned_from(facts: FileFacts, call: CallSite, producers: Sequence[str]) -> bool:
+    """Whether the call's first argument is a name that its function assigns, before the call,
+    from a call to one of ``producers`` (``fd = open ( ... )``, ``int fd = mkstemp ( p ) ;``)."""
+    first = next((a for a in call.arguments if a.keyword is None), None)
+    if first is None or not re.fullmatch(r"[A-Za-z_]\w*", first.text):
+        return False
+    names = "|".join(re.escape(p) for p in producers)
+    assignment = re.compile(rf"(?:^|[\s,(]){re.escape(first.text)} = (?:\( \w+ \) )?(?:{names}) \(")
+    return any(
+        s.function == call.function
+        and s.span.start <= call.span.start
+        and assignment.search(s.text)
+        for s in facts.statements
+    )
 
 
 def _from_file(rule: Rule, site: LinkSite, found: Sequence[tuple[Rule, LinkSite]]) -> LinkSite:

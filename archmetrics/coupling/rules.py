@@ -105,6 +105,9 @@ class Rule:
     description: str = ""
     examples: tuple[tuple[str, str], ...] = ()  # (language, snippet) pairs
     example_endpoint: str | None = None
+    # the call is no link when its first argument was assigned, in the same function, from a
+    # call to one of these (``write(fd, ...)`` after ``fd = open(...)`` writes a file)
+    unless_from: tuple[str, ...] = ()
 
     @property
     def qualified_id(self) -> str:

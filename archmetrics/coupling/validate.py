@@ -24,7 +24,7 @@ from archmetrics.coupling.rules import (
 _PACK_KEYS = frozenset({"name", "description"})
 _RULE_KEYS = frozenset(
     {"id", "language", "match", "kind", "role", "site", "requires", "priority", "endpoint",
-     "description", "example", "example_endpoint"}
+     "description", "example", "example_endpoint", "unless_from"}
 )  # fmt: skip
 _ENDPOINT_KEYS = frozenset(
     {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file"}
@@ -134,6 +134,7 @@ def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
         description=where.text(table, "description", ""),
         examples=_examples(where, table.get("example"), languages),
         example_endpoint=example_endpoint,
+        unless_from=where.texts(table, "unless_from", required=False),
     )
 
 

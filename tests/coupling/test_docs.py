@@ -11,7 +11,7 @@ DOC = Path(__file__).resolve().parents[2] / "docs" / "metrics.md"
 BEGIN, END = "<!-- rules:begin", "<!-- rules:end -->"
 REGENERATE = (
     "regenerate the section with: .venv/bin/python -c 'from archmetrics.coupling import *;"
-    ' print(rules_markdown(load_rule_packs(plugins=False), \"####\"), end=\"\")\''
+    ' print(rules_markdown(load_rule_packs(plugins=False), "####"), end="")\''
 )
 
 

@@ -58,3 +58,24 @@ def test_the_study_proxies_count_one_link_per_command_function() -> None:
         assert len(writes) == source.count("playerc_client_write(")
         counts.append(len(writes))
     assert counts == [counts[0], counts[0] + 1, counts[0] + 2]
+
+
+def test_write_to_a_file_descriptor_just_opened_is_no_socket_link() -> None:
+    from archmetrics.coupling import load_rule_packs, measure_coupling
+    from tests.harness import facts_of
+
+    source = """\
+        #include <sys/socket.h>
+        #include <stdlib.h>
+        #include <unistd.h>
+        int spool(const char *s) {
+            char p[] = "/tmp/xXXXXXX";
+            int fd = mkstemp(p);
+            return (int) write(fd, s, 1);
+        }
+        int reply(int sock, const char *s) { return (int) write(sock, s, 1); }
+        """
+    facts = facts_of(source, "c", "srv.c")
+    report = measure_coupling([facts], None, load_rule_packs(plugins=False))
+    [element] = report.elements
+    assert [(s.line, s.rule) for s in element.link_sites] == [(9, "posix-sockets/c-write")]
