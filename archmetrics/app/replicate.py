@@ -46,6 +46,7 @@ def settings_for(manifest: Manifest) -> Settings:
     return Settings(
         source=str(manifest.path / "manifest.toml"),
         exclude=manifest.exclude,
+        include_generated=not manifest.exclude_generated,
         locations=LocationSettings(
             new=globs.get("new", ()),
             framework=globs.get("framework", ()),

@@ -24,6 +24,7 @@ class Manifest:
     stages: tuple[str, ...]
     locations: tuple[tuple[str, tuple[str, ...]], ...]  # in the manifest's order
     exclude: tuple[str, ...]
+    exclude_generated: bool = True  # [exclude] generated = false counts generated files too
 
     def stage_dir(self, stage: str) -> Path:
         return self.path / stage
@@ -33,6 +34,12 @@ def _strings(value: Any, where: str) -> tuple[str, ...]:
     if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
         raise ManifestError(f"{where}: expected a list of strings")
     return tuple(value)
+
+
+def _flag(value: Any, where: str) -> bool:
+    if not isinstance(value, bool):
+        raise ManifestError(f"{where}: expected true or false")
+    return value
 
 
 def _text(table: dict[str, Any], key: str, where: str) -> str:
@@ -70,6 +77,7 @@ def load_manifest(folder: Path) -> Manifest:
             for name, globs in locations.items()
         ),
         exclude=_strings(exclude.get("paths", []), f"{where}: exclude.paths"),
+        exclude_generated=_flag(exclude.get("generated", True), f"{where}: exclude.generated"),
     )
 
 

@@ -1,0 +1,219 @@
+"""The ``robosoa`` subcommands: each takes parsed arguments and returns an exit status."""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Sequence
+from importlib import import_module
+from typing import Any
+
+from robosoa import connect
+from robosoa.bus import Bus
+from robosoa.errors import RobosoaError
+from robosoa.location import ServiceInfo
+
+DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
+PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so the broker knows its subscribers
+
+
+class UsageError(Exception):
+    """Bad command-line input (exit status 2)."""
+
+
+def parse_pairs(pairs: Sequence[str], raw_json: str | None) -> dict[str, Any]:
+    """``key=value`` words (values parsed as JSON when they are JSON) merged over ``--json``."""
+    payload: dict[str, Any] = {}
+    if raw_json is not None:
+        try:
+            loaded = json.loads(raw_json)
+        except ValueError as exc:
+            raise UsageError(f"--json is not valid JSON: {exc}") from None
+        if not isinstance(loaded, dict):
+            raise UsageError("--json must be a JSON object")
+        payload.update(loaded)
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise UsageError(f"expected key=value, got {pair!r}")
+        try:
+            payload[key] = json.loads(value)
+        except ValueError:
+            payload[key] = value
+    return payload
+
+
+def location_url(text: str | None) -> str:
+    """``--location`` (or $ROBOSOA_LOCATION) as a bus URL; bare tcp:// and ipc:// accepted."""
+    url = text or os.environ.get("ROBOSOA_LOCATION") or DEFAULT_LOCATION
+    return url if url.startswith(("zmq://", "inproc")) else f"zmq://{url}"
+
+
+def _bus(args: argparse.Namespace) -> Bus:
+    return connect(location_url(args.location), location_timeout=args.connect_timeout)
+
+
+def cmd_location(args: argparse.Namespace) -> int:
+    """Run a location service (and its message broker) until SIGINT/SIGTERM."""
+    from robosoa.transports.zmq_location import LocationConfig, LocationServer
+
+    config = LocationConfig(args.bind, args.xsub or "", args.xpub or "", args.ttl,
+                            tuple(args.federate or ()), args.hwm)
+    server = LocationServer(config)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: server.stop())
+    print(f"robosoa location service on {server.endpoint} "
+          f"xsub={server.broker[0]} xpub={server.broker[1]}", flush=True)
+    server.serve()
+    return 0
+
+
+def _health(bus: Bus, info: ServiceInfo, timeout: float) -> str:
+    start = time.perf_counter()
+    try:
+        bus.channel(info.name, info.instance).request("_ping", {}, timeout=timeout)
+    except RobosoaError as exc:
+        return f"DOWN ({exc})"
+    return f"ok {1000 * (time.perf_counter() - start):.1f}ms"
+
+
+def cmd_services(args: argparse.Namespace) -> int:
+    """List live services (``--health``: ping every instance)."""
+    with _bus(args) as bus:
+        infos = bus.services(args.name)
+        health = {i.instance: _health(bus, i, 1.0) for i in infos} if args.health else {}
+    if args.json:
+        rows = [{**i.to_dict(), **({"health": health[i.instance]} if health else {})}
+                for i in infos]
+        print(json.dumps(rows, indent=2))
+        return 0
+    for info in infos:
+        origin = f" via {info.origin}" if info.origin else ""
+        group = f" group={info.group}" if info.group else ""
+        status = f" {health[info.instance]}" if health else ""
+        print(f"{info.name} {info.version} [{info.pattern}] {','.join(info.operations)} "
+              f"{info.endpoint} {info.instance}{group}{origin}{status}")
+    return 0
+
+
+def cmd_call(args: argparse.Namespace) -> int:
+    """Request/response from the command line; prints the reply as JSON."""
+    payload = parse_pairs(args.pairs, args.json)
+    with _bus(args) as bus:
+        reply = bus.request(args.service, args.operation, payload, timeout=args.timeout,
+                            version=args.version)
+    print(json.dumps(reply, sort_keys=True))
+    return 0
+
+
+def cmd_publish(args: argparse.Namespace) -> int:
+    """Publish a topic message (``--count`` times, ``--interval`` apart)."""
+    payload = parse_pairs(args.pairs, args.json)
+    with _bus(args) as bus:
+        time.sleep(PUBLISH_SETTLE)
+        for n in range(args.count):
+            if n:
+                time.sleep(args.interval)
+            if args.event:
+                bus.emit(args.topic, payload)
+            else:
+                bus.publish(args.topic, payload)
+        time.sleep(0.1)  # let ZeroMQ flush before the socket closes
+    return 0
+
+
+def cmd_echo(args: argparse.Namespace) -> int:
+    """Print each message of a topic as one JSON line."""
+    with _bus(args) as bus:
+        listen = bus.on if args.event else bus.subscribe
+        with listen(args.topic) as sub:
+            print(f"listening on {args.topic}", file=sys.stderr, flush=True)
+            seen = 0
+            deadline = None if args.timeout is None else time.monotonic() + args.timeout
+            while args.count is None or seen < args.count:
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    break
+                msg = sub.get(timeout=min(left, 0.5) if left is not None else 0.5)
+                if msg is not None:
+                    seen += 1
+                    print(json.dumps({"topic": msg.topic, "payload": msg.payload}), flush=True)
+    return 0 if args.count is None or seen >= args.count else 1
+
+
+def cmd_stats(args: argparse.Namespace) -> int:
+    """Ask every provider instance for its counters and print them."""
+    rows: list[dict[str, Any]] = []
+    with _bus(args) as bus:
+        for info in bus.services(args.name):
+            try:
+                reply = bus.channel(info.name, info.instance).request("_stats", {},
+                                                                       timeout=args.timeout)
+            except RobosoaError as exc:
+                rows.append({"instance": info.instance, "error": str(exc)})
+                continue
+            for fig in reply.get("figures", []):
+                rows.append({"instance": info.instance, **fig})
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return 0
+    print(f"{'INSTANCE':40} {'ROLE':10} {'KEY':16} {'COUNT':>7} {'ERRORS':>6} {'DROPPED':>7} "
+          f"{'P50_MS':>8} {'P99_MS':>8}")
+    for row in rows:
+        if "error" in row:
+            print(f"{row['instance']:40} unreachable: {row['error']}")
+            continue
+        print(f"{row['instance']:40} {row['role']:10} {row['key']:16} {row['count']:7d} "
+              f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}")
+    return 0
+
+
+def cmd_route(args: argparse.Namespace) -> int:
+    """Run a content-based router service from a rules file until SIGINT/SIGTERM."""
+    from robosoa.router import Router
+
+    router = Router.from_file(args.rules)
+    with _bus(args) as bus, router.attach(bus, args.service):
+        print(f"router {args.service} running with {len(router.rules)} rules", flush=True)
+        stop = False
+
+        def halt(*_: Any) -> None:
+            nonlocal stop
+            stop = True
+
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, halt)
+        while not stop:
+            time.sleep(0.1)
+    return 0
+
+
+def cmd_bridge(args: argparse.Namespace) -> int:
+    """Join two buses until SIGINT/SIGTERM: services and topics of --source on --target."""
+    from robosoa.bridge import Bridge
+
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
+    with connect(location_url(args.source)) as source, \
+            connect(location_url(args.target)) as target, \
+            Bridge(source, target, args.service or (), args.topic or (), args.event or (),
+                   both_ways=args.both_ways):
+        print(f"bridge {args.source} -> {args.target} running", flush=True)
+        stop.wait()
+    return 0
+
+
+def run_gen(words: list[str]) -> int:
+    """Delegate ``gen ...`` / ``validate ...`` to ``robosoa.codegen.cli`` when it is installed
+    (imported lazily: the bus tools work without it)."""
+    try:
+        codegen = import_module("robosoa.codegen.cli")
+    except ImportError as exc:
+        raise RobosoaError(f"code generation is not available: {exc}") from None
+    run: Callable[[list[str]], int | None] = codegen.main
+    return int(run(words) or 0)

@@ -1,0 +1,82 @@
+"""The consumer's view of the location service: lookups, a short cache, instance choice."""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+
+from robosoa.errors import RobosoaError, ServiceNotFound
+from robosoa.location import ServiceInfo, select
+from robosoa.transports.base import BusOptions, ProtocolAdapter
+
+Selection = tuple[float, list[ServiceInfo]]
+
+
+class Directory:
+    """Looks services up through the adapter; caches results for ``options.lookup_cache`` s."""
+
+    def __init__(self, adapter: ProtocolAdapter, options: BusOptions) -> None:
+        self._adapter = adapter
+        self._options = options
+        self._cache: dict[str, Selection] = {}
+        self._chosen: dict[tuple[str, str | None], Selection] = {}
+        self._turn = itertools.count()
+        self._lock = threading.Lock()
+
+    def services(self, name: str | None = None, version: str | None = None,
+                 timeout: float | None = None) -> list[ServiceInfo]:
+        """Ask the location service (never the cache); refreshes the cache for ``name``."""
+        limit = self._options.location_timeout
+        reply = self._adapter.location({"op": "lookup", "name": name},
+                                       limit if timeout is None else min(limit, timeout))
+        if "error" in reply:
+            raise RobosoaError(f"location service: {reply['error']}")
+        infos = [ServiceInfo.from_dict(d) for d in reply.get("services", [])]
+        if name is not None:
+            with self._lock:
+                self._cache[name] = (time.monotonic(), infos)
+        return select(infos, name, version)
+
+    def candidates(self, name: str, version: str | None, fresh: bool,
+                   timeout: float | None = None) -> list[ServiceInfo]:
+        """Instances of ``name`` in the range, best first; from the cache unless ``fresh``."""
+        key = (name, version)
+        with self._lock:
+            cached = self._cache.get(name)
+            chosen = self._chosen.get(key)
+        if not fresh and cached and time.monotonic() - cached[0] < self._options.lookup_cache:
+            if chosen is None or chosen[0] != cached[0]:
+                chosen = (cached[0], select(cached[1], name, version))
+                with self._lock:
+                    self._chosen[key] = chosen
+            if chosen[1]:
+                return chosen[1]
+        return self.services(name, version, timeout)
+
+    def forget(self, name: str) -> None:
+        """Drop the cached lookup (after a failure)."""
+        with self._lock:
+            self._cache.pop(name, None)
+
+    def pick(self, found: list[ServiceInfo]) -> ServiceInfo:
+        """Round robin among the instances of the best version."""
+        if len(found) == 1:
+            return found[0]
+        top = [i for i in found if i.version == found[0].version]
+        return top[next(self._turn) % len(top)]
+
+    def wait_for(self, name: str, timeout: float = 5.0, version: str | None = None,
+                 count: int = 1) -> list[ServiceInfo]:
+        """Block until ``count`` instances are registered; ServiceNotFound after ``timeout``."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                found = self.services(name, version)
+            except RobosoaError:
+                found = []
+            if len(found) >= count:
+                return found
+            if time.monotonic() >= deadline:
+                raise ServiceNotFound(name, f"not registered within {timeout:g}s")
+            time.sleep(0.02)

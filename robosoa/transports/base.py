@@ -1,0 +1,138 @@
+"""The protocol adapter seam (the thesis's SOA_Base, p. 66) that every transport implements.
+
+The bus (MessagingProxy) implements the exchange patterns once, on top of these few
+primitives; a transport only moves messages, answers the location protocol and fans out
+broker channels. Adding a transport means one new module implementing this class.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+from robosoa.errors import RobosoaError
+from robosoa.message import Message
+
+Sink = Callable[[Message], None]  # must never block: it enqueues into a bounded queue
+ReplyFn = Callable[[Message], None]
+
+
+class Unreachable(RobosoaError):
+    """A provider endpoint cannot take a message right now (gone, or its queue is full)."""
+
+
+@dataclass(frozen=True, slots=True)
+class BusOptions:
+    """Tunables of one bus; every queue is bounded by one of these numbers."""
+
+    heartbeat: float = 1.0  # seconds between provider heartbeats to the location service
+    ttl: float = 3.0  # location entries expire this long after the last heartbeat
+    inbox_size: int = 1000  # bounded provider inbox (inproc queue / zmq receive HWM)
+    queue_size: int = 1000  # bounded per-subscription queue; oldest dropped when full
+    hwm: int = 1000  # ZeroMQ send/receive high-water marks
+    lookup_cache: float = 1.0  # seconds a consumer reuses a lookup result
+    location_timeout: float = 2.0  # seconds to wait for the location service
+    provider_bind: str = ""  # zmq: where providers bind, e.g. "tcp://0.0.0.0"; "" = derive
+    advertise_host: str = ""  # zmq: host name/IP other machines use to reach our providers
+
+
+class Incoming(NamedTuple):
+    """One message taken from a provider inbox, or the reason it could not be decoded.
+
+    A NamedTuple rather than a dataclass: one is built per message on the hot path.
+    """
+
+    message: Message | None
+    problem: str
+    reply: ReplyFn | None  # None when the sender expects no reply (one-way)
+
+
+class Inbox(ABC):
+    """A provider instance's bounded receive queue; its endpoint is what gets registered."""
+
+    endpoint: str
+
+    @abstractmethod
+    def receive(self, timeout: float) -> Incoming | None:
+        """The next message, or None after ``timeout`` seconds or once woken for closing."""
+
+    @abstractmethod
+    def wake(self) -> None:
+        """Make a blocked ``receive`` return (thread-safe)."""
+
+    @abstractmethod
+    def close(self) -> None:
+        """Release the endpoint; called from the thread that calls ``receive``."""
+
+
+class ProtocolAdapter(ABC):
+    """SOA_Base plus the message primitives the bus needs."""
+
+    scheme: str = ""
+
+    def __init__(self, address: str, options: BusOptions) -> None:
+        self.address = address
+        self.options = options
+        self.connected = False
+
+    # --- SOA_Base (Hestand 2011, p. 66) ---------------------------------------------
+    @abstractmethod
+    def configure(self) -> None:
+        """Prepare the protocol objects for connection (no communication yet)."""
+
+    @abstractmethod
+    def connect(self) -> None:
+        """Connect and be ready to communicate."""
+
+    def reconnect(self) -> None:
+        """Reuse a connection that was disconnected."""
+        self.connect()
+
+    @abstractmethod
+    def disconnect(self) -> None:
+        """Stop communicating but keep resources so ``reconnect`` can reuse them."""
+
+    @abstractmethod
+    def shutdown(self) -> None:
+        """Release every resource; the adapter cannot be used afterwards."""
+
+    @abstractmethod
+    def ping(self, timeout: float) -> float:
+        """Round-trip seconds to the location service; raises RobosoaError if unreachable."""
+
+    def maintain(self) -> None:
+        """Periodic housekeeping, called from the bus's heartbeat thread (default: nothing)."""
+        return None
+
+    # --- location service -----------------------------------------------------------
+    @abstractmethod
+    def location(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
+        """Send one location-protocol request (see ``robosoa.location``) and return the reply."""
+
+    # --- consumer side --------------------------------------------------------------
+    @abstractmethod
+    def call(self, endpoint: str, msg: Message, timeout: float) -> Message:
+        """Send a request to one provider endpoint and wait for the correlated reply.
+
+        Raises Unreachable if it cannot be handed over, RequestTimeout if no reply comes.
+        """
+
+    @abstractmethod
+    def post(self, endpoint: str, msg: Message) -> None:
+        """Hand a one-way message to one provider endpoint; raises Unreachable."""
+
+    # --- provider side --------------------------------------------------------------
+    @abstractmethod
+    def open_inbox(self, instance: str) -> Inbox:
+        """Open a provider inbox for one service instance."""
+
+    # --- broker (publish/subscribe and events) --------------------------------------
+    @abstractmethod
+    def publish(self, channel: str, raw: bytes) -> None:
+        """Send an encoded message to every subscriber of ``channel`` (never blocks; may drop)."""
+
+    @abstractmethod
+    def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
+        """Deliver messages on ``channel`` to ``sink`` until the returned function is called."""

@@ -1,0 +1,82 @@
+"""A provider instance's inbox over ZeroMQ: a ROUTER socket bound next to the location service."""
+
+from __future__ import annotations
+
+import uuid
+
+import zmq
+
+from robosoa.errors import InvalidMessage
+from robosoa.message import Kind, Message, decode, encode
+from robosoa.transports.base import BusOptions, Inbox, Incoming
+from robosoa.transports.zmq_sockets import bind_provider
+
+_NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
+_MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
+_RCVMORE = int(zmq.RCVMORE)
+
+
+class ZmqInbox(Inbox):
+    """A provider ROUTER: one frame of JSON per message, replies routed by identity.
+
+    The serving thread blocks in ``recv`` (receive timeout); ``wake`` sends a secret token to
+    our own endpoint, so no poller is needed on the hot path.
+    """
+
+    def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
+                 options: BusOptions) -> None:
+        self._ctx = ctx
+        self._router = ctx.socket(zmq.ROUTER)
+        self._router.setsockopt(zmq.LINGER, 0)
+        self._router.setsockopt(zmq.RCVHWM, options.inbox_size)
+        self._router.setsockopt(zmq.SNDHWM, options.hwm)
+        self.endpoint = bind_provider(self._router, location,
+                                      options.provider_bind,
+                                      options.advertise_host)
+        self._bound = str(self._router.getsockopt_string(zmq.LAST_ENDPOINT))
+        self._token = uuid.uuid4().bytes
+        self._timeout = -2
+
+    def receive(self, timeout: float) -> Incoming | None:
+        wait = int(timeout * 1000)
+        if wait != self._timeout:
+            self._router.setsockopt(zmq.RCVTIMEO, wait)
+            self._timeout = wait
+        router = self._router
+        try:
+            identity = router.recv()
+        except zmq.Again:
+            return None
+        data = router.recv() if router.getsockopt(_RCVMORE) else b""
+        extra = 0
+        while router.getsockopt(_RCVMORE):
+            router.recv()
+            extra += 1
+
+        def reply(msg: Message) -> None:
+            raw = encode(msg)
+            router.send(identity, _MORE_NOBLOCK)
+            router.send(raw, _NOBLOCK)
+
+        if extra:
+            return Incoming(None, f"expected one message frame, got {extra + 1}", reply)
+        if data == self._token:
+            return None
+        try:
+            msg = decode(data)
+        except InvalidMessage as exc:
+            return Incoming(None, str(exc), reply)
+        return Incoming(msg, "", None if msg.kind is Kind.ONEWAY else reply)
+
+    def wake(self) -> None:
+        try:
+            sock = self._ctx.socket(zmq.DEALER)
+        except zmq.ZMQError:
+            return  # context already gone: the receiver ends at its timeout anyway
+        sock.setsockopt(zmq.LINGER, 1000)
+        sock.connect(self._bound.replace("0.0.0.0", "127.0.0.1"))
+        sock.send(self._token, zmq.NOBLOCK)
+        sock.close()
+
+    def close(self) -> None:
+        self._router.close(0)

@@ -1,0 +1,116 @@
+"""ZeroMQ socket helpers shared by the zmq adapter and the location service process."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import socket
+import tempfile
+import threading
+import uuid
+from typing import Any
+
+import zmq
+
+from robosoa.errors import RobosoaError
+
+
+def split_endpoint(endpoint: str) -> tuple[str, str, int]:
+    """``tcp://h:p`` -> ("tcp", h, p); ``ipc:///x`` -> ("ipc", "/x", 0)."""
+    scheme, _, rest = endpoint.partition("://")
+    if scheme == "ipc":
+        return scheme, rest, 0
+    if scheme != "tcp" or ":" not in rest:
+        raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: expected tcp://HOST:PORT or "
+                           "ipc:///PATH")
+    host, _, port = rest.rpartition(":")
+    return scheme, host.strip("[]"), int(port) if port.isdigit() else 0
+
+
+def local_ip_towards(host: str) -> str:
+    """The local address this machine uses to reach ``host`` (no packet is sent)."""
+    if host in ("127.0.0.1", "localhost", "::1"):
+        return "127.0.0.1"
+    probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        probe.connect((host, 9))
+        return str(probe.getsockname()[0])
+    except OSError:
+        return socket.gethostname()
+    finally:
+        probe.close()
+
+
+def bind_provider(sock: zmq.Socket[bytes], location: str, bind: str, advertise: str) -> str:
+    """Bind a provider socket next to the location service; return the endpoint to register."""
+    scheme, where, _ = split_endpoint(location)
+    if bind.startswith("ipc://") or (not bind and scheme == "ipc"):
+        folder = bind.removeprefix("ipc://") or os.path.dirname(where) or tempfile.gettempdir()
+        endpoint = f"ipc://{folder}/robosoa-{uuid.uuid4().hex[:12]}.ipc"
+        sock.bind(endpoint)
+        return endpoint
+    reach = local_ip_towards(where)
+    address = bind or f"tcp://{reach if reach == '127.0.0.1' else '0.0.0.0'}"
+    port = sock.bind_to_random_port(address)
+    host = advertise or (split_endpoint(address + ":0")[1] if bind else reach)
+    if host in ("0.0.0.0", "*"):
+        host = reach
+    return f"tcp://{host}:{port}"
+
+
+def public(endpoint: str, location: str) -> str:
+    """Replace a wildcard bind host in ``endpoint`` by the location service's host."""
+    scheme, host, port = split_endpoint(endpoint)
+    if scheme == "tcp" and host in ("0.0.0.0", "*", ""):
+        return f"tcp://{split_endpoint(location)[1]}:{port}"
+    return endpoint
+
+
+def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
+                     request: dict[str, Any], timeout: float) -> dict[str, Any]:
+    """One-shot location-protocol request on a fresh socket (used for federation peers)."""
+    sock = ctx.socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    try:
+        sock.connect(endpoint)
+        sock.send(json.dumps(request).encode())
+        if not sock.poll(int(timeout * 1000), zmq.POLLIN):
+            raise RobosoaError(f"location service at {endpoint} did not answer")
+        reply = json.loads(sock.recv())
+        if not isinstance(reply, dict):
+            raise RobosoaError(f"location service at {endpoint} sent a bad reply")
+        return reply
+    finally:
+        sock.close()
+
+
+class Waker:
+    """A thread-safe way to interrupt a poller: an inproc PAIR pair, send guarded by a lock."""
+
+    def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]]) -> None:
+        address = f"inproc://robosoa-wake-{uuid.uuid4().hex}"
+        self.rx = ctx.socket(zmq.PAIR)
+        self.rx.bind(address)
+        self._tx = ctx.socket(zmq.PAIR)
+        self._tx.connect(address)
+        self._lock = threading.Lock()
+
+    def wake(self) -> None:
+        """Make the poller owning ``rx`` return."""
+        with self._lock, contextlib.suppress(zmq.Again, zmq.ZMQError):
+            self._tx.send(b"!", zmq.NOBLOCK)
+
+    def drain(self) -> None:
+        """Consume pending wake-ups (from the polling thread)."""
+        while True:
+            try:
+                self.rx.recv(zmq.NOBLOCK)
+            except zmq.Again:
+                return
+
+    def close(self) -> None:
+        """Close both ends."""
+        with self._lock:
+            self._tx.close(0)
+        self.rx.close(0)

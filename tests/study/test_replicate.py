@@ -1,0 +1,123 @@
+"""`archmetrics replicate` end to end: the bundled subjects become repositories, are measured
+through the real CLI, and the report, findings and charts are written."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from archmetrics.app.replicate import settings_for, subjects_root
+from archmetrics.cli import main
+from archmetrics.study.findings import FINDINGS
+from archmetrics.study.manifest import ManifestError, find_manifests, load_manifest
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The report folder and the repositories replicate built (kept with --keep-repos)."""
+    out = tmp_path_factory.mktemp("study")
+    repos = tmp_path_factory.mktemp("repos") / "r"
+    code = main(["replicate", "--out", str(out), "--keep-repos", str(repos), "--quiet"])
+    assert code == 0
+    return out, repos
+
+
+@pytest.fixture(scope="module")
+def study(built: tuple[Path, Path]) -> Path:
+    return built[0]
+
+
+@pytest.fixture(scope="module")
+def report(study: Path) -> Any:
+    return json.loads((study / "report.json").read_text())
+
+
+def _total(report: Any, subject: str, approach: str, stage: str, location: str) -> Any:
+    stages = report["subjects"][subject]["series"][approach]["stages"]
+    return next(s for s in stages if s["label"] == stage)["locations"][location]
+
+
+def test_every_subject_approach_and_stage_is_measured(report: Any) -> None:
+    assert report["schema"] == "archmetrics.study/1"
+    approaches = {s: sorted(v["series"]) for s, v in report["subjects"].items()}
+    assert approaches == {
+        "wdb": ["p2p", "player", "soa"],
+        "pragmatics": ["p2p", "player", "soa"],
+        "legacy": ["soa"],
+    }
+    for subject in report["subjects"].values():
+        for series in subject["series"].values():
+            assert [s["label"] for s in series["stages"]] == ["baseline", "first", "second"]
+            baseline = series["stages"][0]
+            assert baseline["base"] == "EMPTY" and baseline["locations"]["total"]["loc_pre"] == 0
+
+
+def test_every_finding_has_a_verdict_from_measured_numbers(report: Any) -> None:
+    assert [f["id"] for f in report["findings"]] == [f.id for f in FINDINGS]
+    for finding in report["findings"]:
+        assert finding["agrees"] in (True, False)
+        assert any(ch.isdigit() for ch in finding["measured"])
+
+
+def test_measured_shapes(report: Any) -> None:
+    # WDB on the bus: after the baseline the client and the glue do not change their coupling
+    for stage in ("first", "second"):
+        for location in ("base", "framework"):
+            s = _total(report, "wdb", "soa", stage, location)
+            assert (s["delta_s_a"], s["delta_s_e"], s["delta_d_a"], s["delta_d_e"]) == (0, 0, 0, 0)
+            assert s["delta_vg"] == 0 and s["cost"] == 0
+    # the P2P baseline is built from socket calls: dynamic efferent coupling appears
+    assert _total(report, "wdb", "p2p", "baseline", "framework")["delta_d_e"] >= 3
+    # the legacy driver never changes: the new location is untouched after the baseline
+    for stage in ("first", "second"):
+        assert _total(report, "legacy", "soa", stage, "new")["changes"] == 0
+
+
+def test_report_and_charts_are_written(study: Path) -> None:
+    markdown = (study / "report.md").read_text()
+    assert "## Findings" in markdown and "## Subject `wdb`" in markdown
+    charts = sorted((study / "charts").iterdir())
+    for subject in ("wdb", "pragmatics", "legacy"):
+        for kind in ("coupling", "scaled_changes", "scaled_complexity", "cost"):
+            for fmt in ("png", "svg"):
+                chart = study / "charts" / f"{subject}-{kind}.{fmt}"
+                assert chart in charts and chart.stat().st_size > 5000
+        assert f"charts/{subject}-cost.png" in markdown
+    assert (study / "charts" / "wdb-cost.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_repositories_have_a_tag_per_stage(built: tuple[Path, Path]) -> None:
+    repo = built[1] / "wdb" / "soa"
+    done = subprocess.run(["git", "-C", str(repo), "tag"], capture_output=True, text=True)
+    assert sorted(done.stdout.split()) == ["baseline", "first", "second"]
+
+
+def test_manifests_load_and_become_settings() -> None:
+    manifests = find_manifests(subjects_root())
+    assert len(manifests) == 7
+    wdb_soa = next(m for m in manifests if (m.subject, m.approach) == ("wdb", "soa"))
+    settings = settings_for(wdb_soa)
+    assert settings.locations.new == ("wdb/**",) and not settings.include_generated
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = ["baseline"]\n', "has no folder"),
+        ('approach = "a"\ntitle = "t"\nstages = []\n', "'subject' must be a non-empty string"),
+        ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = "x"\n', "stages: expected a list"),
+        (
+            'subject = "s"\napproach = "a"\ntitle = "t"\nstages = []\n[exclude]\ngenerated = 1\n',
+            "exclude.generated: expected true or false",
+        ),
+    ],
+)
+def test_bad_manifests_are_named(tmp_path: Path, text: str, message: str) -> None:
+    (tmp_path / "manifest.toml").write_text(text)
+    with pytest.raises(ManifestError, match=message) as error:
+        load_manifest(tmp_path)
+    assert "manifest.toml" in str(error.value)
