@@ -1,0 +1,73 @@
+"""archmetrics as a hook of the real pre-commit framework, in a temporary repository.
+
+pre-commit installs archmetrics from this checkout's HEAD commit into its own environment
+(as it would from a tag on a host), so this test measures what is committed.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.gitrepo import GitRepo
+
+ROOT = Path(__file__).resolve().parents[2]
+PRE_COMMIT = Path(sys.executable).parent / "pre-commit"
+IDENTITY = {
+    "GIT_AUTHOR_NAME": "T",
+    "GIT_AUTHOR_EMAIL": "t@example.invalid",
+    "GIT_COMMITTER_NAME": "T",
+    "GIT_COMMITTER_EMAIL": "t@example.invalid",
+}
+
+
+def _head() -> str:
+    done = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True
+    )
+    if done.returncode != 0:
+        pytest.skip("not running from a git checkout of archmetrics")
+    return done.stdout.strip()
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_hook_gates_the_staged_change(repo: GitRepo, tmp_path: Path) -> None:
+    repo.write(
+        {
+            ".pre-commit-config.yaml": f"repos:\n- repo: {ROOT}\n  rev: {_head()}\n"
+            "  hooks:\n  - id: archmetrics\n",
+            "archmetrics.toml": 'gates = ["added > 3"]\n',
+            "a.py": "x = 1\n",
+        }
+    )
+    env = {
+        **os.environ,
+        **IDENTITY,
+        "PRE_COMMIT_HOME": str(ROOT / ".cache" / "pre-commit"),
+        "ARCHMETRICS_CACHE": str(tmp_path / "facts.sqlite3"),
+    }
+
+    def run(*argv: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            argv, cwd=repo.root, env=env, capture_output=True, text=True, timeout=900
+        )
+
+    assert run(str(PRE_COMMIT), "install").returncode == 0
+    repo.git("add", "-A")
+    first = run("git", "commit", "-m", "first: 1 statement, under the gate")
+    assert first.returncode == 0, first.stdout + first.stderr
+    assert "archmetrics" in first.stdout + first.stderr  # the hook ran
+
+    repo.write({"b.py": "".join(f"v{i} = {i}\n" for i in range(5))})
+    repo.git("add", "b.py")
+    staged = repo.git("diff", "--cached", "--stat")
+    second = run("git", "commit", "-m", "second: 5 statements")
+    assert second.returncode != 0
+    assert "gate failed: added > 3 (added(total) = 5)" in second.stdout + second.stderr
+    assert repo.git("diff", "--cached", "--stat") == staged  # the hook changed nothing
+    assert repo.git("rev-list", "--count", "HEAD").strip() == "1"
