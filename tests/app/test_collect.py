@@ -1,0 +1,53 @@
+"""Parsing a snapshot: the process pool gives exactly what one process gives, and the cache
+serves what it has seen by content, whatever the path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from archmetrics.app.collect import PARALLEL_THRESHOLD, parse_all, select
+from archmetrics.parsers import LanguageTable
+from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.snapshot import DirectorySnapshot
+
+PY = "def f{i}(a):\n    if a > {i}:\n        return [x for x in a if x]\n    return None\n"
+C = "int g{i}(int a) {{\n    switch (a) {{ case {i}: return 1; default: return a && {i}; }}\n}}\n"
+
+
+def _tree(root: Path, count: int) -> DirectorySnapshot:
+    for i in range(count):
+        (root / f"p{i}.py").write_text(PY.format(i=i))
+        (root / f"c{i}.c").write_text(C.format(i=i))
+    return DirectorySnapshot(root)
+
+
+def test_the_pool_gives_what_one_process_gives(tmp_path: Path) -> None:
+    snapshot = _tree(tmp_path, PARALLEL_THRESHOLD)
+    selected = select(snapshot, LanguageTable.default())
+    assert len(selected) == 2 * PARALLEL_THRESHOLD
+    serial = parse_all(snapshot, selected, jobs=1)
+    pooled = parse_all(snapshot, selected, jobs=2)
+    assert pooled == serial
+    assert [f.path for f in pooled] == [s.file.path for s in selected]
+
+
+def test_the_cache_serves_by_content(tmp_path: Path) -> None:
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    snapshot = _tree(tree, 3)
+    selected = select(snapshot, LanguageTable.default())
+    with FactsCache(tmp_path / "cache.sqlite3") as cache:
+        first = parse_all(snapshot, selected, jobs=1, cache=cache)
+        assert (cache.hits, cache.misses) == (0, 6)
+        again = parse_all(snapshot, selected, jobs=1, cache=cache)
+        assert again == first and cache.hits == 6
+    (tree / "moved.py").write_text(PY.format(i=0))  # same content as p0.py, another path
+    with FactsCache(tmp_path / "cache.sqlite3") as cache:
+        moved = [
+            s
+            for s in select(DirectorySnapshot(tree), LanguageTable.default())
+            if s.file.path == "moved.py"
+        ]
+        [facts] = parse_all(DirectorySnapshot(tree), moved, jobs=1, cache=cache)
+        assert cache.hits == 1 and facts.path == "moved.py"
+        assert facts.functions == first[[s.file.path for s in selected].index("p0.py")].functions
