@@ -106,7 +106,10 @@ def _similarities(removed: Sequence[Statement], added: Sequence[Statement]) -> l
     return table
 
 
-def _pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> list[tuple[int, int]]:
+Pairs = list[tuple[int, int, float]]  # (removed index, added index, their token ratio)
+
+
+def _pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs:
     """Order-preserving pairing with the most pairs, then the most summed similarity."""
     m, n = len(removed), len(added)
     ratio = _similarities(removed, added)
@@ -118,7 +121,7 @@ def _pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> lis
                 count, score = best[i - 1][j - 1]
                 value = max(value, (count + 1, score + ratio[i - 1][j - 1]))
             best[i][j] = value
-    pairs: list[tuple[int, int]] = []
+    pairs: Pairs = []
     i, j = m, n
     while i > 0 and j > 0:
         if best[i][j] == best[i - 1][j]:
@@ -126,19 +129,20 @@ def _pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> lis
         elif best[i][j] == best[i][j - 1]:
             j -= 1
         else:
-            pairs.append((i - 1, j - 1))
+            pairs.append((i - 1, j - 1, ratio[i - 1][j - 1]))
             i, j = i - 1, j - 1
     return pairs[::-1]
 
 
-def _pair_greedy(removed: Sequence[Statement], added: Sequence[Statement]) -> list[tuple[int, int]]:
+def _pair_greedy(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs:
     """Fallback for huge runs: each removed statement takes the first partner ahead of the last."""
-    pairs: list[tuple[int, int]] = []
+    pairs: Pairs = []
     start = 0
     for i, r in enumerate(removed):
         for j in range(start, min(start + GREEDY_WINDOW, len(added))):
-            if _may_pair(r, added[j], similarity(r.text, added[j].text)):
-                pairs.append((i, j))
+            ratio = similarity(r.text, added[j].text)
+            if _may_pair(r, added[j], ratio):
+                pairs.append((i, j, ratio))
                 start = j + 1
                 break
     return pairs
@@ -149,14 +153,9 @@ def _replace_run(
 ) -> tuple[list[StatementChange], bool]:
     exact = len(removed) * len(added) <= EXACT_PAIRING_LIMIT
     pairs = (_pair_exact if exact else _pair_greedy)(removed, added)
-    paired_r = {i for i, _ in pairs}
-    paired_a = {j for _, j in pairs}
-    changes = [
-        StatementChange(
-            Action.MODIFIED, removed[i], added[j], similarity(removed[i].text, added[j].text)
-        )
-        for i, j in pairs
-    ]
+    paired_r = {i for i, _, _ in pairs}
+    paired_a = {j for _, j, _ in pairs}
+    changes = [StatementChange(Action.MODIFIED, removed[i], added[j], r) for i, j, r in pairs]
     changes += [
         StatementChange(Action.REMOVED, r, None) for i, r in enumerate(removed) if i not in paired_r
     ]
@@ -193,7 +192,10 @@ def diff_statements(
     post_path: str | None = None,
 ) -> FileChange:
     """Γ_A, Γ_R, Γ_M between two statement sequences of one file, with per-statement detail."""
-    matcher = SequenceMatcher(None, [_key(s) for s in pre], [_key(s) for s in post], autojunk=False)
+    pre_keys, post_keys = [_key(s) for s in pre], [_key(s) for s in post]
+    if pre_keys == post_keys:  # the common case in a diff: nothing changed
+        return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
+    matcher = SequenceMatcher(None, pre_keys, post_keys, autojunk=False)
     changes: list[StatementChange] = []
     approximate = False
     for tag, i1, i2, j1, j2 in matcher.get_opcodes():
