@@ -7,6 +7,7 @@ puts the reader's path back. Anything malformed raises :class:`CodecError`.
 from __future__ import annotations
 
 import json
+from sys import intern
 from typing import Any
 
 from archmetrics.facts import (
@@ -90,29 +91,43 @@ def _decode(document: Any, path: str) -> FileFacts:
     ) = document
     if fmt != FORMAT:
         raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
+    spans: dict[tuple[int, int], Span] = {}
+
+    def span(a: int, b: int) -> Span:
+        """One Span object per line range: statements and calls on a line share it."""
+        found = spans.get((a, b))
+        if found is None:
+            found = spans[(a, b)] = Span(a, b)
+        return found
+
+    def name(text: str | None) -> str | None:
+        return None if text is None else intern(text)
+
     return FileFacts(
         path=path,
-        language=language,
-        statements=tuple(Statement(k, Span(a, b), t, fn) for k, a, b, t, fn in statements),
+        language=intern(language),
+        statements=tuple(
+            Statement(intern(k), span(a, b), t, name(fn)) for k, a, b, t, fn in statements
+        ),
         functions=tuple(
-            Function(n, q, Span(a, b), tuple(Decision(k, line) for k, line in ds), st)
+            Function(n, q, span(a, b), tuple(Decision(intern(k), line) for k, line in ds), st)
             for n, q, a, b, st, ds in functions
         ),
-        classes=tuple(Class(n, q, Span(a, b), k) for n, q, a, b, k in classes),
+        classes=tuple(Class(n, q, span(a, b), k) for n, q, a, b, k in classes),
         dependencies=tuple(
-            Dependency(t, DependencyKind(k), Span(a, b), lv, tuple(ns))
+            Dependency(t, DependencyKind(k), span(a, b), lv, tuple(ns))
             for t, k, a, b, lv, ns in deps
         ),
         call_sites=tuple(
             CallSite(
-                callee,
-                name,
-                recv,
-                Span(a, b),
+                intern(callee),
+                intern(call),
+                name(recv),
+                span(a, b),
                 tuple(Argument(t, v, lit, kw) for t, v, lit, kw in args),
-                fn,
+                name(fn),
             )
-            for callee, name, recv, a, b, fn, args in calls
+            for callee, call, recv, a, b, fn, args in calls
         ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
