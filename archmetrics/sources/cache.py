@@ -27,6 +27,7 @@ from archmetrics.sources import codec
 
 APPLICATION = "archmetrics-facts"
 SCHEMA = "1"
+DECODED_LIMIT = 50_000  # decoded facts kept in memory per run, at most
 
 
 @cache
@@ -67,6 +68,11 @@ class FactsCache:
         self.hits = 0
         self.misses = 0
         self.notices: list[str] = []  # problems recovered from, for the user to see
+        # Facts this run already decoded or parsed, by (blob, language): a diff asks for most
+        # blobs twice (the file is unchanged between base and head), and decoding is the
+        # warm path's main cost. Frozen facts are safe to share (and sharing them halves a
+        # diff's memory); bounded so a long series of revisions does not hold every version.
+        self._decoded: dict[tuple[str, str], FileFacts] = {}
         self._db = self._open()
 
     def _open(self) -> sqlite3.Connection:
@@ -111,6 +117,10 @@ class FactsCache:
         return db
 
     def get(self, blob: str, language: str, path: str) -> FileFacts | None:
+        known = self._decoded.get((blob, language))
+        if known is not None and known.path == path:
+            self.hits += 1
+            return known
         row = self._db.execute(
             "select data from facts where blob=? and language=? and parser=?",
             (blob, language, self.fingerprint),
@@ -128,10 +138,23 @@ class FactsCache:
             self.misses += 1
             return None
         self.hits += 1
+        self.remember(blob, facts)
         return facts
 
+    def remember(self, blob: str, facts: FileFacts) -> None:
+        """Keep ``facts`` (just parsed or decoded) for this run: a later ``get`` of the same
+        blob, language and path returns them without reading or decoding."""
+        if len(self._decoded) >= DECODED_LIMIT:
+            self._decoded.clear()
+        self._decoded[(blob, facts.language)] = facts
+
     def put_many(self, items: Iterable[tuple[str, FileFacts]]) -> None:
-        rows = [(blob, f.language, self.fingerprint, codec.encode(f)) for blob, f in items]
+        self.put_encoded((blob, f.language, codec.encode(f)) for blob, f in items)
+
+    def put_encoded(self, items: Iterable[tuple[str, str, bytes]]) -> None:
+        """Store (blob, language, ``codec.encode(facts)``) rows already encoded elsewhere
+        (the parser processes encode what they send back, so nothing is encoded twice)."""
+        rows = [(blob, language, self.fingerprint, data) for blob, language, data in items]
         self._db.executemany("insert or replace into facts values (?, ?, ?, ?)", rows)
 
     def info(self) -> CacheInfo:
@@ -143,6 +166,7 @@ class FactsCache:
         return CacheInfo(str(self.path), total, size, self.fingerprint, current)
 
     def clear(self) -> int:
+        self._decoded.clear()
         removed: int = self._db.execute("delete from facts").rowcount
         self._db.commit()
         self._db.execute("vacuum")

@@ -3,12 +3,15 @@ serves what it has seen by content, whatever the path."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from archmetrics.app.collect import PARALLEL_THRESHOLD, parse_all, select
+from archmetrics.cli import main
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import DirectorySnapshot
+from tests.gitrepo import GitRepo
 
 PY = "def f{i}(a):\n    if a > {i}:\n        return [x for x in a if x]\n    return None\n"
 C = "int g{i}(int a) {{\n    switch (a) {{ case {i}: return 1; default: return a && {i}; }}\n}}\n"
@@ -51,3 +54,45 @@ def test_the_cache_serves_by_content(tmp_path: Path) -> None:
         [facts] = parse_all(DirectorySnapshot(tree), moved, jobs=1, cache=cache)
         assert cache.hits == 1 and facts.path == "moved.py"
         assert facts.functions == first[[s.file.path for s in selected].index("p0.py")].functions
+
+
+def test_a_diff_is_the_same_without_cache_cold_and_warm(repo: GitRepo, tmp_path: Path) -> None:
+    """The pool sends facts in the cache's encoding: no path may change a number."""
+
+    def tree(change: str = "") -> dict[str, str | bytes]:
+        files: dict[str, str | bytes] = {
+            f"src/m{i}.py": PY.format(i=i) + change for i in range(PARALLEL_THRESHOLD)
+        }
+        files |= {
+            f"native/c{i}.c": C.format(i=i) + change.replace("#", "//")
+            for i in range(PARALLEL_THRESHOLD)
+        }
+        files["src/broken.py"] = "def broken(:\n    pass\n"
+        return files
+
+    repo.commit("one", tag="v1", files=tree())
+    repo.commit("two", tag="v2", files=tree("# changed\nx = 1\n"))
+    diff = [
+        "diff",
+        "-C",
+        str(repo.root),
+        "--base",
+        "v1",
+        "--head",
+        "v2",
+        "-j",
+        "2",
+        "--format",
+        "json",
+        "-q",
+    ]
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+
+    def run(*extra: str) -> object:
+        out = tmp_path / "out.json"
+        assert main([*diff, *extra, "-o", str(out)]) == 0
+        return json.loads(out.read_text())
+
+    plain = run("--no-cache")
+    assert run(*cache) == plain  # cold
+    assert run(*cache) == plain  # warm
