@@ -10,7 +10,7 @@ from __future__ import annotations
 from robosoa.descriptor import Implementation, Operation, Parameter, ServiceDescriptor
 
 from .common import docstring
-from .pytypes import annotation, def_line, field_from, q, result_class, signature
+from .pytypes import annotation, def_line, field_from, literal_lines, q, result_class, signature
 
 _CTYPES = {"int": "ctypes.c_int64", "float": "ctypes.c_double", "bool": "ctypes.c_bool"}
 _CTYPES["string"] = "ctypes.c_char_p"
@@ -65,8 +65,13 @@ def commands(d: ServiceDescriptor, impl: Implementation) -> list[str]:
     lines = ["COMMANDS: dict[str, str] = {"]
     for op in d.operations:
         command = impl.command(op.name)
-        lines.append(f"    {q(op.name)}: {q(command.argv if command else '')},")
+        lines += literal_lines(f"    {q(op.name)}: ", command.argv if command else "", ",")
     return [*lines, "}"]
+
+
+def library(impl: Implementation) -> list[str]:
+    """The ``LIBRARY`` constant: the module or shared library the adapter loads by default."""
+    return literal_lines("LIBRARY = ", impl.library or "")
 
 
 def python_library(d: ServiceDescriptor, impl: Implementation, name: str) -> list[str]:
@@ -75,7 +80,7 @@ def python_library(d: ServiceDescriptor, impl: Implementation, name: str) -> lis
     text = f"Implementation calling the functions of Python module '{module}'."
     lines = [f"class {name}:", *docstring("    ", text), ""]
     lines += [
-        f"    def __init__(self, module: str = {q(module)}) -> None:",
+        "    def __init__(self, module: str = LIBRARY) -> None:",
         "        self._module = importlib.import_module(module)",
     ]
     for op in d.operations:
@@ -100,7 +105,7 @@ def c_library(d: ServiceDescriptor, impl: Implementation, name: str) -> list[str
     text = f"Implementation calling C library '{path}' through ctypes."
     lines = [f"class {name}:", *docstring("    ", text), ""]
     lines += [
-        f"    def __init__(self, path: str = {q(path)}) -> None:",
+        "    def __init__(self, path: str = LIBRARY) -> None:",
         "        self._lib = ctypes.CDLL(path)",
     ]
     for op in d.operations:

@@ -93,10 +93,12 @@ def _adapter(d: ServiceDescriptor, part: Participant, name: str) -> tuple[list[s
         body = [*adapters.commands(d, impl), "", "", *adapters.executable(d, impl, name)]
         return body, [option, f"{skeleton}({name}(args.cwd))"]
     if part.language is Language.C:
-        option = f'"--library", default={q(impl.library)}, help="path of the C shared library"'
-        return adapters.c_library(d, impl, name), [option, f"{skeleton}({name}(args.library))"]
-    option = f'"--module", default={q(impl.library)}, help="implementation module"'
-    return adapters.python_library(d, impl, name), [option, f"{skeleton}({name}(args.module))"]
+        option = '"--library", default=LIBRARY, help="path of the C shared library"'
+        body = [*adapters.library(impl), "", "", *adapters.c_library(d, impl, name)]
+        return body, [option, f"{skeleton}({name}(args.library))"]
+    option = '"--module", default=LIBRARY, help="implementation module"'
+    body = [*adapters.library(impl), "", "", *adapters.python_library(d, impl, name)]
+    return body, [option, f"{skeleton}({name}(args.module))"]
 
 
 def _main(option: str, make: str) -> list[str]:

@@ -17,6 +17,28 @@ def q(value: object) -> str:
     return repr(value)
 
 
+def literal_lines(head: str, value: str, tail: str = "") -> list[str]:
+    """``head + q(value) + tail`` on one line, or the string split into implicitly joined pieces.
+
+    Descriptors carry strings of any length (command lines, library paths); the pieces keep every
+    generated line within 99 columns however long the string is.
+    """
+    line = f"{head}{q(value)}{tail}"
+    if len(line) <= 99:
+        return [line]
+    indent = " " * (len(head) - len(head.lstrip()) + 4)
+    room = 99 - len(indent)
+    pieces: list[str] = []
+    piece = ""
+    for char in value:
+        if piece and len(q(piece + char)) > room:
+            pieces.append(piece)
+            piece = ""
+        piece += char
+    pieces.append(piece)
+    return [f"{head}(", *(f"{indent}{q(p)}" for p in pieces), f"{indent[:-4]}){tail}"]
+
+
 def camel(name: str) -> str:
     """``world_db`` -> ``WorldDb``: class names from service and operation names."""
     return "".join(part[:1].upper() + part[1:] for part in name.split("_"))
