@@ -29,6 +29,7 @@ from archmetrics.parsers import c_tables
 from archmetrics.parsers.c_family_names import (
     call_site,
     function_name,
+    in_order,
     span,
 )
 from archmetrics.parsers.c_family_outline import classes, includes, warnings
@@ -153,9 +154,8 @@ def _parse(path: str, source: str, language: Language) -> FileFacts:
     guard = include_guard(root, data)
     if guard is not None:
         skip.add(guard)
-    nodes = sorted(
-        (node for node in found.get("stmt", []) + _standalone(found) if node.id not in skip),
-        key=lambda node: node.start_byte,
+    nodes = in_order(
+        node for node in found.get("stmt", []) + _standalone(found) if node.id not in skip
     )
     comments = sorted((n.start_byte, n.end_byte) for n in found.get("comment", []))
     clean = blank_comments(data, comments)
@@ -174,7 +174,7 @@ def _parse(path: str, source: str, language: Language) -> FileFacts:
         dependencies=includes(nodes, data),
         call_sites=tuple(
             call_site(node, data, owner.name(node.start_byte))
-            for node in sorted(found.get("call", []), key=lambda node: node.start_byte)
+            for node in in_order(found.get("call", []))
         ),
         sloc=sloc(clean),
         warnings=warnings(path, found, data),
@@ -223,9 +223,7 @@ def _functions(nodes: list[Node], data: bytes) -> list[FunctionSlot]:
     """Function definitions with a body that are not inside another function (as lizard)."""
     slots: list[FunctionSlot] = []
     last_end = -1
-    definitions = sorted(
-        (node for node in nodes if node.type == c_tables.FUNCTION), key=lambda n: n.start_byte
-    )
+    definitions = in_order(node for node in nodes if node.type == c_tables.FUNCTION)
     for node in definitions:
         body = node.child_by_field_name("body")
         if body is None or node.start_byte < last_end:
@@ -251,7 +249,7 @@ def _decisions(found: dict[str, list[Node]], owner: _Owners) -> None:
     not_decisions = {node.id for node in found.get("nodecision", [])}
     directives = sorted((node.start_byte, node.end_byte) for node in found.get("directive", []))
     directive_starts = [start for start, _ in directives]
-    for node in sorted(found.get("decision", []), key=lambda n: n.start_byte):
+    for node in in_order(found.get("decision", [])):
         offset = node.start_byte
         slot = owner.at(offset)
         if slot is None or node.id in not_decisions:
@@ -267,7 +265,7 @@ def _decisions(found: dict[str, list[Node]], owner: _Owners) -> None:
 def _templates(found: dict[str, list[Node]]) -> dict[int, tuple[int, int]]:
     """Start byte of each templated declaration -> (byte, row) where its `template` begins."""
     starts: dict[int, tuple[int, int]] = {}
-    for node in sorted(found.get("template", []), key=lambda n: n.start_byte):
+    for node in in_order(found.get("template", [])):
         inner = node.named_child(node.named_child_count - 1) if node.named_child_count else None
         if inner is None:
             continue

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 
 from tree_sitter import Node
 
@@ -29,6 +30,16 @@ _SPACE_OR_COMMENT = re.compile(rb"\s|/[/*]")
 def text(node: Node, data: bytes) -> bytes:
     """The bytes of ``node``."""
     return data[node.start_byte : node.end_byte]
+
+
+def in_order(nodes: Iterable[Node]) -> list[Node]:
+    """Nodes in document order, the outer of two that start together first.
+
+    Sorting on the start alone is not enough: tree-sitter's query cursor returns captures
+    that start at the same byte (``f(a)(b)`` and ``f(a)``, an ERROR inside an ERROR) in an
+    order that varies with what the process parsed before, and facts must not.
+    """
+    return sorted(nodes, key=lambda n: (n.start_byte, -n.end_byte, n.type))
 
 
 def span(node: Node) -> Span:

@@ -6,7 +6,7 @@ from tree_sitter import Node
 
 from archmetrics.facts import Class, Dependency, DependencyKind, ParseWarning
 from archmetrics.parsers import c_tables
-from archmetrics.parsers.c_family_names import class_name, scopes, span, text
+from archmetrics.parsers.c_family_names import class_name, in_order, scopes, span, text
 from archmetrics.parsers.c_family_text import string_value
 
 _MAX_WARNINGS = 20
@@ -15,7 +15,7 @@ _MAX_WARNINGS = 20
 def classes(nodes: list[Node], data: bytes) -> tuple[Class, ...]:
     """Structs, classes and unions with a body; anonymous ones only under a typedef name."""
     classes: list[Class] = []
-    for node in sorted(nodes, key=lambda n: n.start_byte):
+    for node in in_order(nodes):
         name = class_name(node, data)
         if name is None:
             continue
@@ -48,7 +48,7 @@ def warnings(path: str, found: dict[str, list[Node]], data: bytes) -> tuple[Pars
     """One warning per unparsed region (outermost ERROR) and per token the parser had to invent."""
     problems: list[tuple[int, str]] = []
     last_end = -1
-    for node in sorted(found.get("error", []), key=lambda n: n.start_byte):
+    for node in in_order(found.get("error", [])):
         if node.start_byte < last_end:
             continue
         last_end = node.end_byte

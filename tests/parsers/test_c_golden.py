@@ -508,3 +508,51 @@ def test_sloc_counts_each_line_of_a_continued_macro() -> None:
     source = "#define TWICE(x) \\\n    ((x) + \\\n     (x))\n\\\n\nint y;\n"
     facts = c(source)
     assert (facts.sloc, facts.loc) == (4, 2)  # the lone `\` line holds no token
+
+
+# --- determinism ----------------------------------------------------------------------------
+
+
+def test_nodes_starting_together_are_ordered_outer_first_whatever_the_capture_order() -> None:
+    # tree-sitter's query cursor returns captures that start at the same byte in an order
+    # that depends on what the process parsed before (seen on numpy's _rational_tests.c);
+    # in_order must give one answer for every order it is handed.
+    from tree_sitter import QueryCursor
+
+    from archmetrics.facts import Language
+    from archmetrics.parsers.c_family import grammar
+    from archmetrics.parsers.c_family_names import in_order
+
+    source = b"void f(void) { g(a)(b)(c); }\n"
+    built = grammar(Language.C)
+    calls = QueryCursor(built.query).captures(built.parser.parse(source).root_node)["call"]
+    texts = {source[n.start_byte : n.end_byte].decode() for n in calls}
+    assert texts == {"g(a)(b)(c)", "g(a)(b)", "g(a)"}
+    for order in (calls, calls[::-1], sorted(calls, key=lambda n: n.end_byte)):
+        ordered = in_order(order)
+        assert [source[n.start_byte : n.end_byte].decode() for n in ordered] == [
+            "g(a)(b)(c)",
+            "g(a)(b)",
+            "g(a)",
+        ]
+
+
+def test_the_outermost_unparsed_region_is_the_one_reported_in_any_capture_order() -> None:
+    # `@(void)` is an ERROR holding an ERROR that starts at the same byte: the warning quotes
+    # the outer one, whichever order the query cursor hands them over in.
+    from tree_sitter import QueryCursor
+
+    from archmetrics.facts import Language
+    from archmetrics.parsers.c_family import grammar
+    from archmetrics.parsers.c_family_outline import warnings
+
+    source = b"@(void)\n"
+    built = grammar(Language.C)
+    found = QueryCursor(built.query).captures(built.parser.parse(source).root_node)
+    errors = found["error"]
+    assert sorted((n.start_byte, n.end_byte) for n in errors) == [(0, 1), (0, 7)]
+    for order in (errors, errors[::-1]):
+        reported = warnings("x.c", {"error": list(order)}, source)
+        assert [w.message for w in reported] == [
+            "could not parse '@(void)' (a macro?); lines here may be under-counted"
+        ]
