@@ -6,11 +6,18 @@ of the largest single process (exact, from the kernel's rusage) and the peak of 
 proportional set size (PSS: shared pages split between their sharers, so forked workers do
 not count their parent's pages again) summed over the whole tree, sampled from /proc every
 100 ms (Linux only).
+
+Descendants that outlive their parent are counted too: archmetrics's parser workers are
+children of a multiprocessing fork server, which its parent never waits for, so ``wait4`` on
+the command alone would miss their CPU. This process makes itself a child subreaper
+(``PR_SET_CHILD_SUBREAPER``): such orphans become its children, and their usage is added when
+it reaps them.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import math
 import os
 import signal
@@ -25,6 +32,38 @@ from pathlib import Path
 from corpus import BenchError
 
 SAMPLE_EVERY = 0.1
+_PR_SET_CHILD_SUBREAPER = 36
+
+
+def _become_subreaper() -> bool:
+    """Adopt orphaned descendants (Linux); False where the platform has no such thing."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return bool(libc.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0)
+    except (OSError, AttributeError):
+        return False
+
+
+SUBREAPER = _become_subreaper()
+
+
+def _reap_orphans(deadline: float) -> tuple[float, int]:
+    """Wait for the adopted descendants still running: their CPU seconds, summed, and the
+    largest peak RSS among them (kB)."""
+    cpu, max_rss = 0.0, 0
+    while SUBREAPER:
+        try:
+            pid, _, usage = os.wait4(-1, os.WNOHANG)
+        except ChildProcessError:
+            break  # none left
+        if pid == 0:
+            if time.monotonic() > deadline:
+                break
+            time.sleep(0.01)
+            continue
+        cpu += usage.ru_utime + usage.ru_stime
+        max_rss = max(max_rss, usage.ru_maxrss)
+    return cpu, max_rss
 
 
 @dataclass(frozen=True, slots=True)
@@ -139,6 +178,7 @@ def run_once(
             sampler.start()
         _, status, usage = os.wait4(process.pid, 0)
         wall = time.perf_counter() - start
+        orphans_cpu, orphans_rss = _reap_orphans(time.monotonic() + 30)
         timer.cancel()
         sampler.done.set()
         process.returncode = os.waitstatus_to_exitcode(status)
@@ -148,7 +188,10 @@ def run_once(
         tail = log.read_text(errors="replace")[-2000:]
         raise BenchError(f"exit {process.returncode}: {' '.join(command)}\n{tail}")
     return Run(
-        wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, sampler.peak_kb / 1024
+        wall,
+        usage.ru_utime + usage.ru_stime + orphans_cpu,
+        max(usage.ru_maxrss, orphans_rss) / 1024,
+        sampler.peak_kb / 1024,
     )
 
 

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import gc
+import multiprocessing
+import multiprocessing.context
 import os
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -100,20 +101,23 @@ def parse_all(
             todo.append(_Todo(index, item, blob, data))
         results[index] = hit
     progress.start("parsing", len(todo))
+
+    def keep(entry: _Todo, facts: FileFacts, encoded: bytes | None) -> None:
+        results[entry.index] = facts
+        if cache is not None:  # stored as each file arrives: encoded bytes are not held on
+            data = encoded if encoded is not None else codec.encode(facts)
+            cache.put_encoded([(entry.blob, facts.language, data)])
+            cache.remember(entry.blob, facts)
+
     try:
-        parsed = _parse(snapshot, todo, overrides, worker_count(jobs), progress)
+        _parse(snapshot, todo, overrides, worker_count(jobs), progress, keep)
     finally:
         progress.stop()
-    for entry, (facts, _) in zip(todo, parsed, strict=True):
-        results[entry.index] = facts
-    if cache is not None:
-        cache.put_encoded(
-            (entry.blob, facts.language, encoded if encoded is not None else codec.encode(facts))
-            for entry, (facts, encoded) in zip(todo, parsed, strict=True)
-        )
-        for entry, (facts, _) in zip(todo, parsed, strict=True):
-            cache.remember(entry.blob, facts)
     return tuple(f for f in results if f is not None)
+
+
+Keep = Callable[[_Todo, FileFacts, bytes | None], None]
+"""Receives each parsed file: its entry, its facts, and their encoding if a worker made it."""
 
 
 def _payload(snapshot: Snapshot, entry: _Todo) -> tuple[str, bytes, str]:
@@ -127,16 +131,16 @@ def _parse(
     overrides: tuple[tuple[str, str], ...],
     workers: int,
     progress: Progress,
-) -> list[tuple[FileFacts, bytes | None]]:
-    """Facts for each entry, with their encoding when a worker process made it."""
+    keep: Keep,
+) -> None:
+    """Parse each entry and hand it to ``keep``, in a process pool when there are many."""
     if workers == 1 or len(todo) < PARALLEL_THRESHOLD:
         table = LanguageTable.default(dict(overrides))
-        results: list[tuple[FileFacts, bytes | None]] = []
         for entry in todo:
-            results.append((parse_source(*_payload(snapshot, entry), table), None))
+            keep(entry, parse_source(*_payload(snapshot, entry), table), None)
             progress.advance()
-        return results
-    return _parse_parallel(snapshot, todo, overrides, workers, progress)
+        return
+    _parse_parallel(snapshot, todo, overrides, workers, progress, keep)
 
 
 def _parse_parallel(
@@ -145,33 +149,45 @@ def _parse_parallel(
     overrides: tuple[tuple[str, str], ...],
     workers: int,
     progress: Progress,
-) -> list[tuple[FileFacts, bytes | None]]:
+    keep: Keep,
+) -> None:
     """Batches go to a process pool; at most a few batches per worker are read ahead, so
-    memory stays bounded however large the tree is."""
+    memory stays bounded however large the tree is.
+
+    The workers come from a fork server started before the first pool, while this process
+    is still small: forked from here instead, each worker of a diff's second revision would
+    inherit (and, as its allocator touches the pages, copy) all the facts of the first.
+    """
     starts = range(0, len(todo), BATCH)
-    results: list[tuple[FileFacts, bytes | None]] = []
     window: deque[tuple[Future[list[bytes]], Sequence[_Todo]]] = deque()
-    gc.freeze()  # forked workers then never touch (and so never copy) what we already hold
-    try:
-        with ProcessPoolExecutor(workers, initializer=_init_worker, initargs=(overrides,)) as pool:
-            for batch in (todo[i : i + BATCH] for i in starts):
-                payload = [_payload(snapshot, e) for e in batch]
-                window.append((pool.submit(_parse_batch, payload), batch))
-                if len(window) >= workers * 3:
-                    results.extend(_collect(*window.popleft(), progress))
-            while window:
-                results.extend(_collect(*window.popleft(), progress))
-    finally:
-        gc.unfreeze()
-    return results
+    with ProcessPoolExecutor(
+        workers, mp_context=_context(), initializer=_init_worker, initargs=(overrides,)
+    ) as pool:
+        for batch in (todo[i : i + BATCH] for i in starts):
+            payload = [_payload(snapshot, e) for e in batch]
+            window.append((pool.submit(_parse_batch, payload), batch))
+            if len(window) >= workers * 3:
+                _collect(*window.popleft(), progress, keep)
+        while window:
+            _collect(*window.popleft(), progress, keep)
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    """The fork server where the platform has one (its workers start small), else the default."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context()
+    context = multiprocessing.get_context("forkserver")
+    # the fork server imports the parsers once; every worker starts with them loaded
+    context.set_forkserver_preload(
+        ["archmetrics.app.collect", "archmetrics.parsers.python", "archmetrics.parsers.c_family"]
+    )
+    return context
 
 
 def _collect(
-    future: Future[list[bytes]], batch: Sequence[_Todo], progress: Progress
-) -> list[tuple[FileFacts, bytes | None]]:
+    future: Future[list[bytes]], batch: Sequence[_Todo], progress: Progress, keep: Keep
+) -> None:
     encoded = future.result()
     progress.advance(len(encoded))
-    return [
-        (codec.decode(data, entry.item.file.path), data)
-        for data, entry in zip(encoded, batch, strict=True)
-    ]
+    for data, entry in zip(encoded, batch, strict=True):
+        keep(entry, codec.decode(data, entry.item.file.path), data)

@@ -34,6 +34,20 @@ def test_the_pool_gives_what_one_process_gives(tmp_path: Path) -> None:
     assert [f.path for f in pooled] == [s.file.path for s in selected]
 
 
+def test_the_pool_stores_every_file_it_parses(tmp_path: Path) -> None:
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    snapshot = _tree(tree, PARALLEL_THRESHOLD)
+    selected = select(snapshot, LanguageTable.default())
+    with FactsCache(tmp_path / "cache.sqlite3") as cache:
+        pooled = parse_all(snapshot, selected, jobs=2, cache=cache)
+        assert (cache.hits, cache.misses) == (0, len(selected))
+    with FactsCache(tmp_path / "cache.sqlite3") as cache:
+        again = parse_all(snapshot, selected, jobs=2, cache=cache)
+        assert (cache.hits, cache.misses) == (len(selected), 0)
+    assert again == pooled
+
+
 def test_the_cache_serves_by_content(tmp_path: Path) -> None:
     tree = tmp_path / "tree"
     tree.mkdir()
