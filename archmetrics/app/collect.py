@@ -19,6 +19,7 @@ from archmetrics.sources.snapshot import blob_hash
 
 PARALLEL_THRESHOLD = 48  # below this many files, a process pool costs more than it saves
 BATCH = 16
+WORKER_BATCHES = 8  # a worker is replaced after this many batches: parse trees leave arenas behind
 
 
 @dataclass(frozen=True, slots=True)
@@ -161,7 +162,11 @@ def _parse_parallel(
     starts = range(0, len(todo), BATCH)
     window: deque[tuple[Future[list[bytes]], Sequence[_Todo]]] = deque()
     with ProcessPoolExecutor(
-        workers, mp_context=_context(), initializer=_init_worker, initargs=(overrides,)
+        workers,
+        mp_context=_context(),
+        initializer=_init_worker,
+        initargs=(overrides,),
+        max_tasks_per_child=WORKER_BATCHES,
     ) as pool:
         for batch in (todo[i : i + BATCH] for i in starts):
             payload = [_payload(snapshot, e) for e in batch]
