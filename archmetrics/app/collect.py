@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import multiprocessing
 import multiprocessing.context
 import os
@@ -19,7 +20,6 @@ from archmetrics.sources.snapshot import blob_hash
 
 PARALLEL_THRESHOLD = 48  # below this many files, a process pool costs more than it saves
 BATCH = 16
-WORKER_BATCHES = 8  # a worker is replaced after this many batches: parse trees leave arenas behind
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,9 +47,10 @@ def select(
 _worker_table: LanguageTable | None = None
 
 
-def _init_worker(overrides: tuple[tuple[str, str], ...]) -> None:
+def _init_worker(overrides: tuple[tuple[str, str], ...], thresholds: tuple[int, ...]) -> None:
     global _worker_table
     _worker_table = LanguageTable.default(dict(overrides))
+    gc.set_threshold(*thresholds)  # the parent's: libcst builds millions of nodes per batch
 
 
 def _parse_batch(batch: list[tuple[str, bytes, str]]) -> list[bytes]:
@@ -161,13 +162,7 @@ def _parse_parallel(
     """
     starts = range(0, len(todo), BATCH)
     window: deque[tuple[Future[list[bytes]], Sequence[_Todo]]] = deque()
-    with ProcessPoolExecutor(
-        workers,
-        mp_context=_context(),
-        initializer=_init_worker,
-        initargs=(overrides,),
-        max_tasks_per_child=WORKER_BATCHES,
-    ) as pool:
+    with _pool(workers, overrides) as pool:
         for batch in (todo[i : i + BATCH] for i in starts):
             payload = [_payload(snapshot, e) for e in batch]
             window.append((pool.submit(_parse_batch, payload), batch))
@@ -175,6 +170,15 @@ def _parse_parallel(
                 _collect(*window.popleft(), progress, keep)
         while window:
             _collect(*window.popleft(), progress, keep)
+
+
+def _pool(workers: int, overrides: tuple[tuple[str, str], ...]) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        workers,
+        mp_context=_context(),
+        initializer=_init_worker,
+        initargs=(overrides, gc.get_threshold()),
+    )
 
 
 def _context() -> multiprocessing.context.BaseContext:
