@@ -10,8 +10,11 @@ from __future__ import annotations
 import ast
 import re
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import libcst as cst
+from libcst._nodes.base import CSTNode
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers.python_walk import FactsWalker
@@ -25,7 +28,8 @@ def parse(path: str, source: str) -> FileFacts:
     if "\r" in source:  # Python reads \r\n and lone \r as newlines; so do we
         source = source.replace("\r\n", "\n").replace("\r", "\n")
     try:
-        module = cst.parse_module(source)
+        with _unvalidated_nodes():
+            module = cst.parse_module(source)
     except cst.ParserSyntaxError as error:
         message = _ERROR_PREFIX.sub("", error.message)
         return _unparsed(path, _error_line(error, source), f"Python syntax error: {message}")
@@ -48,6 +52,29 @@ def parse(path: str, source: str) -> FileFacts:
         call_sites=tuple(c for c in walker.calls if c is not None),
         sloc=walker.sloc(source),
     )
+
+
+def _no_validation(node: CSTNode) -> None:
+    """Stands in for ``CSTNode.__post_init__`` while the parser builds a tree."""
+
+
+@contextmanager
+def _unvalidated_nodes() -> Iterator[None]:
+    """libcst checks every node as it is built (``CSTNode.__post_init__`` calls
+    ``_validate``), which is there for trees built by hand: nodes the parser builds from
+    accepted source satisfy those checks by construction, as libcst's own comment on that
+    method says. Skipping them takes a quarter off ``parse_module``, the dominant cost of
+    measuring Python (docs/performance.md). The hook is put back when the parse ends, even
+    on error, so nodes built anywhere else are still checked."""
+    original = CSTNode.__dict__.get("__post_init__")
+    if original is None:  # a libcst without the hook: nothing to skip
+        yield
+        return
+    CSTNode.__post_init__ = _no_validation  # type: ignore[method-assign,assignment]
+    try:
+        yield
+    finally:
+        CSTNode.__post_init__ = original  # type: ignore[method-assign]
 
 
 def _unparsed(path: str, line: int, message: str) -> FileFacts:
