@@ -3,12 +3,20 @@
 Parsers turn bytes into a :class:`FileFacts`; everything downstream (complexity, coupling,
 change sets, reports) reads only these values. Every fact carries the line span it came
 from, so any number in a report can be traced back to the source lines behind it.
+
+The records a file has many of (statements, calls and their arguments, functions, decisions,
+spans) are named tuples: immutable like frozen dataclasses, but built by the tuple's C
+constructor (a frozen dataclass sets each field through ``object.__setattr__``, four times
+slower), and, holding only strings, numbers and other such tuples, dropped from the cyclic
+collector's lists after its first look at them. A release of numpy has two million of them;
+docs/performance.md has the figures. Compare them only with records of their own type.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import NamedTuple
 
 
 class Language(StrEnum):
@@ -19,23 +27,26 @@ class Language(StrEnum):
     CPP = "cpp"
 
 
-@dataclass(frozen=True, slots=True, order=True)
-class Span:
-    """An inclusive range of 1-based physical lines."""
-
+class _Lines(NamedTuple):
     start: int
     end: int
 
-    def __post_init__(self) -> None:
-        if self.start < 1 or self.end < self.start:
-            raise ValueError(f"bad span {self.start}-{self.end}")
+
+class Span(_Lines):
+    """An inclusive range of 1-based physical lines (ordered by start, then end)."""
+
+    __slots__ = ()
+
+    def __new__(cls, start: int, end: int) -> Span:
+        if start < 1 or end < start:
+            raise ValueError(f"bad span {start}-{end}")
+        return tuple.__new__(cls, (start, end))
 
     def contains(self, line: int) -> bool:
         return self.start <= line <= self.end
 
 
-@dataclass(frozen=True, slots=True)
-class Statement:
+class Statement(NamedTuple):
     """One logical line of code (λ counts these), as defined on thesis page 103.
 
     ``kind`` is the syntax node that made it a statement (the rule-table row in
@@ -51,16 +62,14 @@ class Statement:
     function: str | None = None  # qualified name of the enclosing function, if any
 
 
-@dataclass(frozen=True, slots=True)
-class Decision:
+class Decision(NamedTuple):
     """One McCabe decision point (+1 to v_g): ``kind`` names the construct, e.g. ``if``, ``&&``."""
 
     kind: str
     line: int
 
 
-@dataclass(frozen=True, slots=True)
-class Function:
+class Function(NamedTuple):
     """A function or method. ``complexity`` is McCabe's v_g = 1 + decision points."""
 
     name: str
@@ -74,8 +83,7 @@ class Function:
         return 1 + len(self.decisions)
 
 
-@dataclass(frozen=True, slots=True)
-class Class:
+class Class(NamedTuple):
     """A class, struct or union definition (C/C++ ``struct`` with a body counts)."""
 
     name: str
@@ -90,8 +98,7 @@ class DependencyKind(StrEnum):
     IMPORT = "import"  # import a.b / from a.b import c
 
 
-@dataclass(frozen=True, slots=True)
-class Dependency:
+class Dependency(NamedTuple):
     """A static dependency as written in the source: an include or an import.
 
     For Python, ``target`` is the module named (``a.b`` for ``from a.b import c``, ``""``
@@ -109,8 +116,7 @@ class Dependency:
 Literal = str | int | float | bool | None
 
 
-@dataclass(frozen=True, slots=True)
-class Argument:
+class Argument(NamedTuple):
     """One argument at a call site: its literal value when it is a literal, else None.
 
     ``text`` is the argument's normalized source text, so a reader can see what it was.
@@ -122,8 +128,7 @@ class Argument:
     keyword: str | None = None
 
 
-@dataclass(frozen=True, slots=True)
-class CallSite:
+class CallSite(NamedTuple):
     """A call as written: the raw material for dynamic coupling.
 
     ``callee`` is the called expression's text (``bus.request``, ``zmq_connect``,

@@ -55,8 +55,15 @@ class StatementChange:
     action: Action
     pre: Statement | None  # None for added
     post: Statement | None  # None for removed
-    similarity: float | None = None  # token ratio of a modified pair
     moved: bool = False  # removed/added text that reappears unchanged on the other side
+
+    @property
+    def similarity(self) -> float | None:
+        """Token ratio of a modified pair (None otherwise), computed when asked: the pairing
+        needs it only where it has a choice, and one statement can be thousands of tokens."""
+        if self.action is not Action.MODIFIED or self.pre is None or self.post is None:
+            return None
+        return similarity(self.pre.text, self.post.text)
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,14 +155,29 @@ def _pair_greedy(removed: Sequence[Statement], added: Sequence[Statement]) -> Pa
     return pairs
 
 
+def _pair_one(removed: Statement, added: Statement) -> Pairs:
+    """A run of one removed and one added statement: they pair when they may, and there is
+    nothing to choose, so the ratio is computed only when the kinds differ."""
+    if removed.kind == added.kind:
+        return [(0, 0, 1.0)]  # the ratio is not needed (and not kept): see StatementChange
+    matcher = SequenceMatcher(None, tokens(removed.text), tokens(added.text), autojunk=False)
+    if matcher.quick_ratio() < SIMILARITY_THRESHOLD:
+        return []
+    ratio = matcher.ratio()
+    return [(0, 0, ratio)] if ratio >= SIMILARITY_THRESHOLD else []
+
+
 def _replace_run(
     removed: Sequence[Statement], added: Sequence[Statement]
 ) -> tuple[list[StatementChange], bool]:
     exact = len(removed) * len(added) <= EXACT_PAIRING_LIMIT
-    pairs = (_pair_exact if exact else _pair_greedy)(removed, added)
+    if len(removed) == len(added) == 1:
+        pairs = _pair_one(removed[0], added[0])
+    else:
+        pairs = (_pair_exact if exact else _pair_greedy)(removed, added)
     paired_r = {i for i, _, _ in pairs}
     paired_a = {j for _, j, _ in pairs}
-    changes = [StatementChange(Action.MODIFIED, removed[i], added[j], r) for i, j, r in pairs]
+    changes = [StatementChange(Action.MODIFIED, removed[i], added[j]) for i, j, _ in pairs]
     changes += [
         StatementChange(Action.REMOVED, r, None) for i, r in enumerate(removed) if i not in paired_r
     ]
@@ -192,8 +214,10 @@ def diff_statements(
     post_path: str | None = None,
 ) -> FileChange:
     """Γ_A, Γ_R, Γ_M between two statement sequences of one file, with per-statement detail."""
+    if pre is post:  # the cache hands both revisions one object for an unchanged blob
+        return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
     pre_keys, post_keys = [_key(s) for s in pre], [_key(s) for s in post]
-    if pre_keys == post_keys:  # the common case in a diff: nothing changed
+    if pre_keys == post_keys:  # nothing changed but layout or comments
         return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
     matcher = SequenceMatcher(None, pre_keys, post_keys, autojunk=False)
     changes: list[StatementChange] = []

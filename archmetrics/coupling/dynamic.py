@@ -46,6 +46,7 @@ def _strip_nested(pattern: re.Pattern[str], text: str, empty: str) -> str:
     return text
 
 
+@lru_cache(maxsize=1 << 16)
 def normalize_callee(callee: str) -> str:
     """A callee as rules see it: no spaces, no template arguments, ``->``/``::`` as ``.``."""
     if not _SPECIAL.search(callee):
@@ -91,6 +92,7 @@ class RuleIndex:
     def __init__(self, rules: Sequence[Rule]) -> None:
         self.by_name: dict[str, list[tuple[int, Rule, str]]] = {}
         self.wild: list[tuple[int, Rule, str]] = []
+        self.chosen: dict[tuple[str, bool], Rule | None] = {}  # callees repeat: ask once
         for order, rule in enumerate(rules):
             for pattern in rule.match:
                 last = normalize_callee(pattern).rsplit(".", 1)[-1]
@@ -105,7 +107,13 @@ class RuleIndex:
 
         With ``module_receiver`` (the receiver is a module name) ``*``-patterns do not match.
         """
-        name = normalize_callee(callee)
+        key = (callee, module_receiver)
+        if key in self.chosen:
+            return self.chosen[key]
+        rule = self.chosen[key] = self._choose(normalize_callee(callee), module_receiver)
+        return rule
+
+    def _choose(self, name: str, module_receiver: bool) -> Rule | None:
         best: tuple[int, int, Rule] | None = None
         for order, rule, pattern in (*self.by_name.get(name.rsplit(".", 1)[-1], ()), *self.wild):
             if module_receiver and pattern.startswith("*"):
@@ -114,6 +122,13 @@ class RuleIndex:
             if (best is None or rank > best[:2]) and _compiled(pattern).match(name):
                 best = (*rank, rule)
         return best[2] if best else None
+
+
+@lru_cache(maxsize=256)
+def rule_index(rules: tuple[Rule, ...]) -> RuleIndex:
+    """The index of these rules, shared by every file that can use the same ones (rules are
+    frozen values, so equal tuples index alike)."""
+    return RuleIndex(rules)
 
 
 def choose_rule(callee: str, rules: Sequence[Rule], module_receiver: bool = False) -> Rule | None:
@@ -217,7 +232,7 @@ def file_link_sites(
         r for r in rules.for_language(facts.language)
         if not r.requires or any(want in forms for want in r.requires)
     ]  # fmt: skip
-    calls = RuleIndex([r for r in usable if r.site is SiteKind.CALL])
+    calls = rule_index(tuple(r for r in usable if r.site is SiteKind.CALL))
     found: list[tuple[Rule, LinkSite]] = []
     for call in facts.call_sites:
         receiver = normalize_callee(call.receiver) if call.receiver else None
@@ -226,7 +241,7 @@ def file_link_sites(
             endpoint, note = read_endpoint(call, rule.endpoint, facts.call_sites, read)
             site = _site(facts.path, call.span.start, rule, call.callee, endpoint, call.function)
             found.append((rule, replace(site, note=note)))
-    definitions = RuleIndex([r for r in usable if r.site is SiteKind.DEFINITION])
+    definitions = rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION))
     for function in facts.functions:
         if rule := definitions.choose(function.qualified_name):
             spec, name = rule.endpoint, function.qualified_name

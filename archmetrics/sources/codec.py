@@ -27,6 +27,8 @@ from archmetrics.facts import (
 
 FORMAT = 1
 
+_new = tuple.__new__
+
 
 class CodecError(ValueError):
     """A cache entry that is not facts in our format."""
@@ -97,37 +99,58 @@ def _decode(document: Any, path: str) -> FileFacts:
         """One Span object per line range: statements and calls on a line share it."""
         found = spans.get((a, b))
         if found is None:
-            found = spans[(a, b)] = Span(a, b)
+            found = spans[(a, b)] = Span(a, b)  # checks the range: the bytes are not trusted
         return found
 
-    def name(text: str | None) -> str | None:
-        return None if text is None else intern(text)
-
+    # The records are named tuples, built here by tuple's own constructor (their fields are
+    # unpacked above it, so a record of the wrong length still fails); optional names are
+    # None or a string, and ``x and intern(x)`` keeps None as None.
     return FileFacts(
         path=path,
         language=intern(language),
         statements=tuple(
-            Statement(intern(k), span(a, b), t, name(fn)) for k, a, b, t, fn in statements
+            [
+                _new(Statement, (intern(k), span(a, b), t, fn and intern(fn)))
+                for k, a, b, t, fn in statements
+            ]
         ),
         functions=tuple(
-            Function(n, q, span(a, b), tuple(Decision(intern(k), line) for k, line in ds), st)
-            for n, q, a, b, st, ds in functions
+            [
+                _new(
+                    Function,
+                    (
+                        n,
+                        q,
+                        span(a, b),
+                        tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
+                        st,
+                    ),
+                )
+                for n, q, a, b, st, ds in functions
+            ]
         ),
-        classes=tuple(Class(n, q, span(a, b), k) for n, q, a, b, k in classes),
+        classes=tuple([Class(n, q, span(a, b), k) for n, q, a, b, k in classes]),
         dependencies=tuple(
-            Dependency(t, DependencyKind(k), span(a, b), lv, tuple(ns))
-            for t, k, a, b, lv, ns in deps
+            [
+                Dependency(t, DependencyKind(k), span(a, b), lv, tuple(ns))
+                for t, k, a, b, lv, ns in deps
+            ]
         ),
         call_sites=tuple(
-            CallSite(
-                intern(callee),
-                intern(call),
-                name(recv),
-                span(a, b),
-                tuple(Argument(t, v, lit, kw) for t, v, lit, kw in args),
-                name(fn),
-            )
-            for callee, call, recv, a, b, fn, args in calls
+            [
+                _new(
+                    CallSite,
+                    (
+                        intern(callee),
+                        intern(call),
+                        recv and intern(recv),
+                        span(a, b),
+                        tuple([_new(Argument, (t, v, lit, kw)) for t, v, lit, kw in args]),
+                        fn and intern(fn),
+                    ),
+                )
+                for callee, call, recv, a, b, fn, args in calls
+            ]
         ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
