@@ -155,25 +155,23 @@ def _pair_greedy(removed: Sequence[Statement], added: Sequence[Statement]) -> Pa
     return pairs
 
 
-def _pair_one(removed: Statement, added: Statement) -> Pairs:
-    """A run of one removed and one added statement: they pair when they may, and there is
-    nothing to choose, so the ratio is computed only when the kinds differ."""
-    if removed.kind == added.kind:
-        return [(0, 0, 1.0)]  # the ratio is not needed (and not kept): see StatementChange
-    matcher = SequenceMatcher(None, tokens(removed.text), tokens(added.text), autojunk=False)
-    if matcher.quick_ratio() < SIMILARITY_THRESHOLD:
-        return []
-    ratio = matcher.ratio()
-    return [(0, 0, ratio)] if ratio >= SIMILARITY_THRESHOLD else []
+def _forced(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs | None:
+    """The pairing when there is nothing to choose: as many removed as added statements, each
+    of the same kind as its counterpart. Pairing position by position then pairs them all,
+    and no other order-preserving pairing does, so rule 2 picks it whatever the token ratios
+    are; they are not computed (in the numpy diff such runs held 2.2 s of 4 s of ratios)."""
+    if len(removed) != len(added) or any(r.kind != a.kind for r, a in zip(removed, added)):
+        return None
+    return [(i, i, 1.0) for i in range(len(removed))]  # 1.0: unused, see StatementChange
 
 
 def _replace_run(
     removed: Sequence[Statement], added: Sequence[Statement]
 ) -> tuple[list[StatementChange], bool]:
-    exact = len(removed) * len(added) <= EXACT_PAIRING_LIMIT
-    if len(removed) == len(added) == 1:
-        pairs = _pair_one(removed[0], added[0])
-    else:
+    exact = True
+    pairs = _forced(removed, added)
+    if pairs is None:
+        exact = len(removed) * len(added) <= EXACT_PAIRING_LIMIT
         pairs = (_pair_exact if exact else _pair_greedy)(removed, added)
     paired_r = {i for i, _, _ in pairs}
     paired_a = {j for _, j, _ in pairs}

@@ -219,7 +219,10 @@ def test_greedy_pairing_is_flagged_in_the_summary(monkeypatch: pytest.MonkeyPatc
 
     monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 1)
     report = run(
-        FilePair(facts("client/a.py", "a = 1", "b = 1"), facts("client/a.py", "a = 2", "b = 2"))
+        FilePair(
+            facts("client/a.py", "a = 1", "b = 1"),
+            facts("client/a.py", "a = 2", "b = 2", "c = 2"),  # 2 x 3: a choice, so greedy
+        )
     )
     assert report.total.modified == 2
     assert any(n.startswith("pairing_approximate: 'client/a.py'") for n in report.total.notes)

@@ -74,12 +74,46 @@ def test_similarity_is_over_tokens() -> None:
 
 def test_huge_replace_runs_pair_greedily_and_say_so(monkeypatch: pytest.MonkeyPatch) -> None:
     pre = stmts(*[("call", f"old_{i}(a)") for i in range(30)])
-    post = stmts(*[("call", f"new_{i}(a)") for i in range(30)])
+    post = stmts(*[("call", f"new_{i}(a)") for i in range(31)])
     exact = diff_statements(pre, post)
-    assert not exact.approximate and exact.modified == 30
+    assert not exact.approximate and (exact.modified, exact.added) == (30, 1)
     monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 100)
     rough = diff_statements(pre, post)
-    assert rough.approximate and rough.modified == 30
+    assert rough.approximate and (rough.modified, rough.added) == (30, 1)
+
+
+def test_a_square_run_of_matching_kinds_pairs_in_place_at_any_size(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    pre = stmts(*[("call" if i % 3 else "if", f"old_{i}(a)") for i in range(30)])
+    post = stmts(*[("call" if i % 3 else "if", f"new({i})") for i in range(30)])
+    monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 100)
+    change = diff_statements(pre, post)
+    assert not change.approximate and change.modified == 30
+    assert [(c.pre, c.post) for c in change.changes] == list(zip(pre, post, strict=True))
+    assert change.changes[0].similarity == similarity("old_0(a)", "new(0)")  # when asked
+
+
+_PAIR_TEXTS = st.text("ab(=) ", max_size=8)
+_SAME_KINDS = st.lists(
+    st.tuples(st.sampled_from(["assign", "call", "if"]), _PAIR_TEXTS), min_size=1, max_size=8
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(_SAME_KINDS, st.data())
+def test_the_in_place_pairing_is_what_the_exact_rule_chooses(
+    pre_items: list[tuple[str, str]], data: st.DataObject
+) -> None:
+    size = len(pre_items)
+    texts = data.draw(st.lists(_PAIR_TEXTS, min_size=size, max_size=size))
+    removed = stmts(*pre_items)
+    added = stmts(*[(kind, text) for (kind, _), text in zip(pre_items, texts, strict=True)])
+    forced = statement_diff._forced(removed, added)
+    assert forced is not None
+    assert [(i, j) for i, j, _ in statement_diff._pair_exact(removed, added)] == [
+        (i, j) for i, j, _ in forced
+    ]
 
 
 _KINDS = st.sampled_from(["assign", "call", "if", "return"])
