@@ -160,7 +160,9 @@ def _forced(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs |
     of the same kind as its counterpart. Pairing position by position then pairs them all,
     and no other order-preserving pairing does, so rule 2 picks it whatever the token ratios
     are; they are not computed (in the numpy diff such runs held 2.2 s of 4 s of ratios)."""
-    if len(removed) != len(added) or any(r.kind != a.kind for r, a in zip(removed, added)):
+    if len(removed) != len(added):
+        return None
+    if any(r.kind != a.kind for r, a in zip(removed, added, strict=True)):
         return None
     return [(i, i, 1.0) for i in range(len(removed))]  # 1.0: unused, see StatementChange
 
