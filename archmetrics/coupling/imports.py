@@ -42,6 +42,8 @@ class ModuleIndex:
         self.files = frozenset(f for f in files if f.endswith(".py"))
         self.folders = frozenset(folder for f in self.files for folder in _ancestors(f))
         self.roots = tuple(roots) if roots is not None else self._detect_roots()
+        self._found: dict[tuple[tuple[str, ...], tuple[str, ...]], tuple[str, str | None] | None]
+        self._found = {}  # every file imports os, sys, numpy ...: each lookup is made once
 
     def _is_package(self, folder: str) -> bool:
         return _join(folder, "__init__.py") in self.files
@@ -92,10 +94,12 @@ class ModuleIndex:
         return self._resolve((base,), parts, dep.names, written, absolute=False)
 
     def _find(self, roots: tuple[str, ...], parts: list[str]) -> tuple[str, str | None] | None:
-        for root in roots:
-            if found := self.locate(root, parts):
-                return found
-        return None
+        key = (roots, tuple(parts))
+        if key in self._found:
+            return self._found[key]
+        found = next((hit for root in roots if (hit := self.locate(root, parts))), None)
+        self._found[key] = found
+        return found
 
     def _resolve(self, roots: tuple[str, ...], parts: list[str], names: tuple[str, ...],
                  written: str, absolute: bool) -> list[ImportResolution]:  # fmt: skip

@@ -94,13 +94,23 @@ def _decode(document: Any, path: str) -> FileFacts:
     if fmt != FORMAT:
         raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
     spans: dict[tuple[int, int], Span] = {}
+    known = spans.get  # `known((a, b)) or span(a, b)`: only a C call for a range seen before
 
     def span(a: int, b: int) -> Span:
         """One Span object per line range: statements and calls on a line share it."""
-        found = spans.get((a, b))
-        if found is None:
-            found = spans[(a, b)] = Span(a, b)  # checks the range: the bytes are not trusted
-        return found
+        made = spans[(a, b)] = Span(a, b)  # checks the range: the bytes are not trusted
+        return made
+
+    lists: dict[tuple[Argument, ...], tuple[Argument, ...]] = {}
+
+    def arguments(args: list[list[Any]]) -> tuple[Argument, ...]:
+        """A call's arguments. Calls in a file repeat the same ones (``self``, ``NULL``, ``0``):
+        equal lists share one tuple. (An argument's value follows from its text, so equal
+        tuples never mix up ``1``, ``1.0`` and ``True``.)"""
+        if not args:
+            return ()
+        made = tuple([_new(Argument, (intern(t), v, lit, kw)) for t, v, lit, kw in args])
+        return lists.setdefault(made, made)
 
     # The records are named tuples, built here by tuple's own constructor (their fields are
     # unpacked above it, so a record of the wrong length still fails); optional names are
@@ -110,7 +120,10 @@ def _decode(document: Any, path: str) -> FileFacts:
         language=intern(language),
         statements=tuple(
             [
-                _new(Statement, (intern(k), span(a, b), t, fn and intern(fn)))
+                _new(
+                    Statement,
+                    (intern(k), known((a, b)) or span(a, b), intern(t), fn and intern(fn)),
+                )
                 for k, a, b, t, fn in statements
             ]
         ),
@@ -121,7 +134,7 @@ def _decode(document: Any, path: str) -> FileFacts:
                     (
                         n,
                         q,
-                        span(a, b),
+                        known((a, b)) or span(a, b),
                         tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
                         st,
                     ),
@@ -129,10 +142,10 @@ def _decode(document: Any, path: str) -> FileFacts:
                 for n, q, a, b, st, ds in functions
             ]
         ),
-        classes=tuple([Class(n, q, span(a, b), k) for n, q, a, b, k in classes]),
+        classes=tuple([Class(n, q, known((a, b)) or span(a, b), k) for n, q, a, b, k in classes]),
         dependencies=tuple(
             [
-                Dependency(t, DependencyKind(k), span(a, b), lv, tuple(ns))
+                Dependency(t, DependencyKind(k), known((a, b)) or span(a, b), lv, tuple(ns))
                 for t, k, a, b, lv, ns in deps
             ]
         ),
@@ -144,8 +157,8 @@ def _decode(document: Any, path: str) -> FileFacts:
                         intern(callee),
                         intern(call),
                         recv and intern(recv),
-                        span(a, b),
-                        tuple([_new(Argument, (t, v, lit, kw)) for t, v, lit, kw in args]),
+                        known((a, b)) or span(a, b),
+                        arguments(args),
                         fn and intern(fn),
                     ),
                 )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sqlite3
 from pathlib import Path
 
@@ -76,6 +77,34 @@ def test_codec_round_trips_real_parser_output(language: str) -> None:
     }[language]
     facts = facts_of(source, language)
     assert codec.decode(codec.encode(facts), facts.path) == facts
+
+
+def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types() -> None:
+    source = "def f(self):\n    g(self, 0)\n    g(self, 0)\n    h(1)\n    h(1.0)\n    h(True)\n"
+    facts = facts_of(source, "python")
+    first = codec.decode(codec.encode(facts), facts.path)
+    again = codec.decode(codec.encode(facts), facts.path)
+    assert first == facts
+    g1, g2, h1, h2, h3 = first.call_sites
+    assert g1.arguments is g2.arguments  # one tuple for equal argument lists
+    values = [h.arguments[0].value for h in (h1, h2, h3)]
+    assert values == [1, 1.0, True] and [type(v) for v in values] == [int, float, bool]
+    assert first.statements[1].text is again.statements[1].text  # texts are interned
+
+
+def _tampered(edit: str) -> bytes:
+    document = json.loads(codec.encode(SAMPLE))
+    if edit == "span":
+        document[2][0][1] = 0  # a statement starting on line 0
+    else:
+        document[6][0][6][0] = ["x", None]  # an argument with two fields of four
+    return json.dumps(document).encode()
+
+
+@pytest.mark.parametrize("edit", ["span", "argument"])
+def test_codec_rejects_tampered_records(edit: str) -> None:
+    with pytest.raises(codec.CodecError):
+        codec.decode(_tampered(edit), "x.py")
 
 
 @pytest.mark.parametrize("bad", [b"", b"[]", b"{}", b"[2]", b"not json", b'[1, "python"]'])
