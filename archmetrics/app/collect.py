@@ -60,8 +60,8 @@ def _init_worker(overrides: tuple[tuple[str, str], ...]) -> None:
 
 
 def _parse_batch(batch: list[tuple[str, bytes, str]]) -> list[bytes]:
-    """Facts for a batch, encoded the cache's way: a third of pickle's cost to send and
-    receive (frozen slots dataclasses unpickle field by field), and ready to store."""
+    """Facts for a batch, encoded the cache's way: ready to store, and cheaper to send and
+    receive than pickle (a third of its cost when measured, docs/performance.md)."""
     assert _worker_table is not None
     encoded = [
         codec.encode(parse_source(path, data, language, _worker_table))
