@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import libcst as cst
-from libcst._nodes.base import CSTNode
+from libcst import CSTNode
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers.python_walk import FactsWalker
