@@ -17,6 +17,7 @@ import libcst as cst
 from libcst import CSTNode
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
+from archmetrics.parsers import python_ast
 from archmetrics.parsers.python_walk import FactsWalker
 
 _ERROR_AT = re.compile(r"error at (\d+):(\d+)")
@@ -27,6 +28,27 @@ def parse(path: str, source: str) -> FileFacts:
     """Facts of one Python file (``generated`` is left to the registry)."""
     if "\r" in source:  # Python reads \r\n and lone \r as newlines; so do we
         source = source.replace("\r\n", "\n").replace("\r", "\n")
+    tree = _standard_tree(source)
+    if tree is not None:
+        try:
+            return python_ast.read(path, source, tree)
+        except Exception:  # libcst below reads it, the same rules
+            pass
+    return parse_with_libcst(path, source)
+
+
+def _standard_tree(source: str) -> ast.Module | None:
+    """The running interpreter's syntax tree of ``source``, or None when it rejects it."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "invalid escape sequence" is the author's business
+            return ast.parse(source)
+    except (SyntaxError, ValueError, RecursionError, MemoryError, OverflowError):
+        return None
+
+
+def parse_with_libcst(path: str, source: str) -> FileFacts:
+    """Facts of one Python file through libcst (newlines already normalized)."""
     try:
         with _unvalidated_nodes():
             module = cst.parse_module(source)

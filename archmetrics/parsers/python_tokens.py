@@ -28,7 +28,8 @@ class TokenState(CodegenState):
 
     ``toks[i]`` is the i-th significant token, ``starts[i]``/``ends[i]`` its first and last
     line. Comments never enter the list. An f-string is glued into one token (its literal
-    text is not to be re-spaced). Subclasses observe nodes through ``enter``/``leave`` tables.
+    text is not to be re-spaced): from its opening quote to its closing one, without the
+    parentheses around it. Subclasses observe nodes through ``enter``/``leave`` tables.
     """
 
     enter: Mapping[type[cst.CSTNode], Hook] = {}
@@ -40,15 +41,21 @@ class TokenState(CodegenState):
         self.toks: list[str] = []
         self.starts: list[int] = []
         self.ends: list[int] = []
-        self.fstring_depth = 0
-        self.fstring_fresh = False
+        self.fstring_depth = 0  # nested FormattedString nodes we are in
+        self.fstring_fresh = False  # the outermost f-string's first token is still to come
+        self.fstring_open = False  # its closing quote is still to come
+        self.part_depth = 0  # > 0 inside an f-string's text or replacement field
         self.skip_depth = 0  # > 0 inside a node whose tokens are not code (a docstring)
         self.code_lines: set[int] = set()
         self.multiline_code: list[tuple[int, int]] = []  # code tokens spanning lines
+        self.waiting: list[list[int]] = []  # cells to receive the next token's line
 
     # -- CodegenState protocol -------------------------------------------------------------
     def add_indent_tokens(self) -> None:
-        """Indentation is whitespace: nothing to record."""
+        """Indentation is whitespace, except inside an f-string, whose text is kept as
+        written (a replacement field can run over lines)."""
+        if self.part_depth:
+            self.toks[-1] += "".join(self.indent_tokens)
 
     def pop_trailing_newline(self) -> None:
         """We keep no raw token list, so there is no trailing newline to drop."""
@@ -57,13 +64,21 @@ class TokenState(CodegenState):
         start = self.line
         if "\n" in value:
             self.line += value.count("\n")
-        if self.fstring_depth and not self.fstring_fresh:
-            self.toks[-1] += value
+        if self.waiting and value[:1] != "#" and value.strip(_BLANK):
+            for cell in self.waiting:
+                cell.append(start)
+            self.waiting.clear()
+        if self.part_depth or (self.fstring_open and self.fstring_depth):
+            self.toks[-1] += value  # inside an f-string: its text, or its closing quote
             self.ends[-1] = self.line
+            if not self.part_depth:
+                self.fstring_open = False
         elif value[:1] == "#" or not value.strip(_BLANK):
             return  # a comment or whitespace
         else:
-            self.fstring_fresh = False
+            if self.fstring_fresh and value != "(":  # not a parenthesis around the f-string
+                self.fstring_fresh = False
+                self.fstring_open = True
             self.toks.append(value)
             self.starts.append(start)
             self.ends.append(self.line)
@@ -80,6 +95,8 @@ class TokenState(CodegenState):
             if not self.fstring_depth:
                 self.fstring_fresh = True
             self.fstring_depth += 1
+        elif kind is cst.FormattedStringText or kind is cst.FormattedStringExpression:
+            self.part_depth += 1
         hook = self.enter.get(kind)
         if hook is not None:
             hook(self, node)
@@ -91,6 +108,8 @@ class TokenState(CodegenState):
             hook(self, node)
         if kind is cst.FormattedString:
             self.fstring_depth -= 1
+        elif kind is cst.FormattedStringText or kind is cst.FormattedStringExpression:
+            self.part_depth -= 1
 
     def record_syntactic_position(  # type: ignore[override]  # any context manager will do
         self,
@@ -106,6 +125,15 @@ class TokenState(CodegenState):
         """Called where a node's own syntax begins (after its comments and decorators)."""
 
     # -- reading the stream -----------------------------------------------------------------
+    def next_line(self) -> list[int]:
+        """A cell that receives the line of the next significant token when it is emitted.
+
+        Inside an f-string the tokens are glued into one, so a token index cannot give the
+        line of a construct there; this can."""
+        cell: list[int] = []
+        self.waiting.append(cell)
+        return cell
+
     def text(self, first: int, last: int) -> str:
         """Normalized text of tokens ``first:last``: joined by single spaces."""
         return " ".join(self.toks[first:last])

@@ -34,7 +34,7 @@ class _Frame:
     qualified_name: str
     slot: int
     start: int  # token index where its own syntax begins (after decorators)
-    decisions: list[tuple[str, int]] = field(default_factory=list)  # (kind, token index)
+    decisions: list[tuple[str, list[int]]] = field(default_factory=list)  # (kind, [line])
     statements: int = 0
 
 
@@ -59,7 +59,7 @@ class FactsWalker(TokenState):
         self.else_kinds: dict[int, str] = {}
         self.catch_alls: set[int] = set()
         self.simple_starts: list[int] = []
-        self.call_starts: list[tuple[int, int]] = []  # (first token, output slot)
+        self.call_starts: list[tuple[int, int, list[int]]] = []  # (first token, slot, [line])
         self.arg_starts: dict[int, int] = {}
         self.syntax_starts: dict[int, int] = {}
 
@@ -82,9 +82,10 @@ class FactsWalker(TokenState):
             self.funcs[-1].statements += 1
 
     def decide(self, kind: str) -> None:
-        """A decision point at the next token, for the function whose body we are in."""
+        """A decision point at the next token (its line: that token's, also inside an
+        f-string), for the function whose body we are in."""
         if not self.suppress and self.targets and self.targets[-1] is not None:
-            self.targets[-1].decisions.append((kind, len(self.toks)))
+            self.targets[-1].decisions.append((kind, self.next_line()))
 
     def open_header(self, kind: str) -> None:
         """A compound statement starts: its header runs until its body (or first case)."""
@@ -132,7 +133,7 @@ class FactsWalker(TokenState):
         self.targets.pop()
         self.names.pop()
         start = self.syntax_starts.pop(id(node), frame.start)
-        decisions = tuple(Decision(kind, self.first_line(i)) for kind, i in frame.decisions)
+        decisions = tuple(Decision(kind, line) for kind, (line,) in frame.decisions)
         span = self.span(start, len(self.toks))
         self.functions[frame.slot] = Function(
             frame.name, frame.qualified_name, span, decisions, frame.statements
@@ -231,14 +232,14 @@ class FactsWalker(TokenState):
 
     # -- calls ----------------------------------------------------------------------------
     def enter_call(self, node: cst.Call) -> None:
-        self.call_starts.append((len(self.toks), len(self.calls)))
+        self.call_starts.append((len(self.toks), len(self.calls), self.next_line()))
         self.calls.append(None)
 
     def enter_arg(self, node: cst.Arg) -> None:
         self.arg_starts[id(node)] = len(self.toks)
 
     def leave_call(self, node: cst.Call) -> None:
-        first, slot = self.call_starts.pop()
+        first, slot, (line,) = self.call_starts.pop()
         end = len(self.toks)
         starts = [self.arg_starts.pop(id(arg), first) for arg in node.args]
         if self.fstring_depth:  # inside an f-string the tokens are glued: rebuild the text
@@ -246,7 +247,7 @@ class FactsWalker(TokenState):
         else:
             callee, receiver, arguments = calls.from_tokens(self, node, first, end, starts)
         name = node.func.attr.value if isinstance(node.func, cst.Attribute) else callee
-        span = self.span(first, end)
+        span = Span(line, max(line, self.last_line(end)))
         self.calls[slot] = CallSite(callee, name, receiver, span, arguments, self.owner())
 
 

@@ -2,9 +2,11 @@
 
 Git names every file version by its blob hash, and files read from disk are hashed the same
 way, so a file is parsed once per content however many revisions, paths or runs see it. The
-parser fingerprint is a hash of the parser code itself, so a new archmetrics never trusts
-facts an older one wrote. Rule packs are applied to facts after the cache (coupling reads
-call sites, which do not depend on rules), so they need no part in the key.
+parser fingerprint is a hash of the parser code itself, of the Python version and of the
+parsing libraries' versions, so archmetrics never trusts facts that another version of it,
+of Python (whose ``ast`` reads Python files), of libcst or of tree-sitter wrote. Rule packs
+are applied to facts after the cache (coupling reads call sites, which do not depend on
+rules), so they need no part in the key.
 
 A corrupt file, or one that is not ours, is moved aside with a warning and a new cache is
 built; a bad entry is dropped and parsed again. The cache is never trusted blindly.
@@ -15,10 +17,12 @@ from __future__ import annotations
 import hashlib
 import os
 import sqlite3
+import sys
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cache
+from importlib import metadata
 from pathlib import Path
 
 import archmetrics
@@ -30,15 +34,25 @@ SCHEMA = "1"
 DECODED_LIMIT = 50_000  # decoded facts kept in memory per run, at most
 
 
+_PARSING_LIBRARIES = ("libcst", "tree-sitter", "tree-sitter-c", "tree-sitter-cpp")
+
+
 @cache
 def parser_fingerprint() -> str:
-    """A hash of the code that makes facts: the parsers package and facts.py."""
+    """A hash of what makes facts: the parsers package, facts.py, the Python version (its
+    ``ast`` reads Python files) and the versions of the parsing libraries."""
     root = Path(archmetrics.__file__).parent
     digest = hashlib.sha256(archmetrics.__version__.encode())
     for path in sorted([root / "facts.py", *(root / "parsers").glob("*.py")]):
         digest.update(path.name.encode())
         digest.update(path.read_bytes())
     digest.update(str(codec.FORMAT).encode())
+    digest.update(sys.version.encode())
+    for library in _PARSING_LIBRARIES:
+        try:
+            digest.update(f"{library} {metadata.version(library)}".encode())
+        except metadata.PackageNotFoundError:
+            digest.update(f"{library} absent".encode())
     return digest.hexdigest()[:16]
 
 

@@ -1,4 +1,7 @@
-"""Golden cases for the Python parser: one per row of the tables in docs/metrics.md."""
+"""Golden cases for the Python parser: one per row of the tables in docs/metrics.md.
+
+Every case runs through both Python readers (``ast`` and libcst, tests/parsers/conftest.py).
+"""
 
 from __future__ import annotations
 
@@ -10,6 +13,8 @@ from radon.complexity import cc_visit
 from archmetrics.facts import Argument, Dependency, DependencyKind, FileFacts, Severity, Span
 from archmetrics.parsers import LanguageTable, parse_source
 from tests.harness import complexities, facts_of, statement_kinds
+
+pytestmark = pytest.mark.usefixtures("python_reader")
 
 
 def py(source: str) -> FileFacts:
@@ -541,6 +546,66 @@ def test_calls_inside_fstrings_are_found() -> None:
         "render",
         (Argument("item"), Argument("'wide'", "wide", True)),
     )
+
+
+def test_arguments_keep_the_order_they_are_written_in() -> None:
+    found = arguments("call(a, *b, c=1, *d, **e)\n")
+    assert [(a.text, a.keyword) for a in found] == [
+        ("a", None),
+        ("* b", None),
+        ("1", "c"),
+        ("* d", None),
+        ("** e", None),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("source", "texts"),
+    [
+        ("f(lambda a=1, b=2: a, 3)", ["lambda a = 1 , b = 2 : a", "3"]),
+        ("f(x for x, y in z)", ["x for x , y in z"]),
+        ("f((x for x in y), 1,)", ["( x for x in y )", "1"]),
+        ("f((a), {b: c, d: e}, [g, h])", ["( a )", "{ b : c , d : e }", "[ g , h ]"]),
+    ],
+)
+def test_argument_texts_hold_their_own_commas(source: str, texts: list[str]) -> None:
+    assert [a.text for a in arguments(source + "\n")] == texts
+
+
+def test_true_false_and_none_are_names_to_a_callee() -> None:
+    assert calls("True.__index__()\n") == [("True.__index__", "__index__", "True")]
+
+
+def test_a_call_in_parentheses_spans_them() -> None:
+    (site,) = py("x = (\n    connect(1)\n)\n").call_sites
+    assert site.span == Span(1, 3)
+
+
+def test_calls_and_decisions_inside_fstrings_have_their_own_lines() -> None:
+    source = (
+        'def f():\n    s = f"""{\n        a if b else c} {g(\n        1)}"""\n'
+        '    t = f"{x or y}"\n    return s + t\n'
+    )
+    facts = py(source)
+    (function,) = facts.functions
+    assert [(d.kind, d.line) for d in function.decisions] == [("ifexp", 3), ("or", 5)]
+    assert [(c.callee, c.span) for c in facts.call_sites] == [("g", Span(3, 4))]
+
+
+def test_an_fstring_in_parentheses_is_one_token_without_them() -> None:
+    assert texts('x = (\n    f"{a}"  # note\n)\n') == ['x = ( f"{a}" )']
+
+
+def test_an_fstring_keeps_its_text_as_written_over_lines() -> None:
+    source = 'def f(d):\n    c = f"""{\n        g(1,\n          2) if d else 0\n    }"""\n'
+    assert texts(source)[1] == 'c = f"""{\n        g(1,\n          2) if d else 0\n    }"""'
+
+
+def test_relative_import_text_names_each_dot() -> None:
+    assert texts("from ... import x\nfrom .... import y\n") == [
+        "from . . . import x",
+        "from . . . . import y",
+    ]
 
 
 # --- SLOC ---------------------------------------------------------------------------------

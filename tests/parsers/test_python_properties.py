@@ -10,11 +10,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from radon.complexity import cc_visit
 
-from archmetrics.parsers import LanguageTable, parse_source
+from archmetrics.facts import FileFacts
+from archmetrics.parsers import LanguageTable, parse_source, python, python_ast
 from archmetrics.parsers.python import parse
 
 _TABLE = LanguageTable.default(plugins=False)
@@ -141,6 +142,17 @@ def test_generated_programs_have_the_counted_lines_and_decisions(
     relaid = parse("gen.py", program(body, second))
     assert [s.text for s in relaid.statements] == [s.text for s in facts.statements]
     assert [s.kind for s in relaid.statements] == [s.kind for s in facts.statements]
+    assert python.parse_with_libcst("gen.py", source) == facts
+
+
+def both_readers(path: str, text: str) -> tuple[FileFacts, FileFacts]:
+    """The ``ast`` reader's facts and libcst's, of source both can read."""
+    source = text.replace("\r\n", "\n").replace("\r", "\n")
+    tree = python._standard_tree(source)
+    assume(tree is not None)
+    through_libcst = python.parse_with_libcst(path, source)
+    assume(through_libcst.parsed)
+    return python_ast.read(path, source, tree), through_libcst
 
 
 @settings(max_examples=300, deadline=None)
@@ -199,6 +211,13 @@ def test_python_like_fragments_never_raise(text: str) -> None:
     assert facts.loc == len(facts.statements)
     for statement in facts.statements:
         assert statement.span.start >= 1 and statement.text
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(PYTHONISH)
+def test_both_readers_agree_on_python_like_fragments(text: str) -> None:
+    through_ast, through_libcst = both_readers("frag.py", text)
+    assert through_ast == through_libcst
 
 
 @settings(max_examples=200, deadline=None)

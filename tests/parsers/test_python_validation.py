@@ -28,14 +28,14 @@ def test_facts_are_the_same_as_with_libcst_validating_every_node(
     path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     source = path.read_text(encoding="utf-8")
-    fast = python.parse(str(path), source)
+    fast = python.parse_with_libcst(str(path), source)
     monkeypatch.setattr(python, "_unvalidated_nodes", contextlib.nullcontext)
-    assert python.parse(str(path), source) == fast
+    assert python.parse_with_libcst(str(path), source) == fast
     assert fast.parsed and fast.statements
 
 
 @pytest.mark.parametrize("source", ["x = 1\n", "def f(:\n"], ids=["parsed", "syntax-error"])
 def test_nodes_built_by_hand_are_still_validated_after_a_parse(source: str) -> None:
-    python.parse("m.py", source)
+    python.parse_with_libcst("m.py", source)
     with pytest.raises(cst.CSTValidationError):
         cst.Name("")

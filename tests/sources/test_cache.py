@@ -22,6 +22,7 @@ from archmetrics.facts import (
     Span,
     Statement,
 )
+from archmetrics.sources import cache as cache_module
 from archmetrics.sources import codec
 from archmetrics.sources.cache import FactsCache
 from tests.harness import facts_of
@@ -156,3 +157,22 @@ def test_bad_entry_is_dropped_and_reparsed(tmp_path: Path) -> None:
         cache._db.execute("update facts set data = ?", (b"garbage",))
         assert cache.get("abc", "python", "a/b.py") is None
         assert cache.info().entries == 0
+
+
+def test_facts_other_parsers_wrote_are_not_served(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+    monkeypatch.setattr(cache_module, "parser_fingerprint", lambda: "another-archmetrics")
+    with FactsCache(path) as cache:
+        assert cache.get("abc", "python", "a/b.py") is None
+        assert (cache.info().entries, cache.info().current_entries) == (1, 0)
+
+
+def test_the_fingerprint_names_the_python_that_parsed(monkeypatch: pytest.MonkeyPatch) -> None:
+    ours = cache_module.parser_fingerprint.__wrapped__()
+    assert cache_module.parser_fingerprint.__wrapped__() == ours
+    monkeypatch.setattr(cache_module.sys, "version", "3.99.0 (another)")
+    assert cache_module.parser_fingerprint.__wrapped__() != ours
