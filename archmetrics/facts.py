@@ -14,9 +14,12 @@ docs/performance.md has the figures. Compare them only with records of their own
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import NamedTuple
+from typing import Any, Generic, NamedTuple, TypeVar, overload
+
+T = TypeVar("T")
 
 
 class Language(StrEnum):
@@ -103,7 +106,9 @@ class Dependency(NamedTuple):
 
     For Python, ``target`` is the module named (``a.b`` for ``from a.b import c``, ``""``
     for ``from . import c``), ``level`` the number of leading dots of a relative import and
-    ``names`` the names imported from it. For C/C++, ``target`` is the include path.
+    ``names`` the names imported from it; ``bound`` the names the statement binds in the
+    file: ``a`` for ``import a.b``, ``c`` for ``import a.b as c``, and for ``from m import x
+    as y, z`` one per name (``y``, ``z``). For C/C++, ``target`` is the include path.
     """
 
     target: str
@@ -111,6 +116,7 @@ class Dependency(NamedTuple):
     span: Span
     level: int = 0
     names: tuple[str, ...] = ()
+    bound: tuple[str, ...] = ()
 
 
 Literal = str | int | float | bool | None
@@ -162,13 +168,68 @@ class ParseWarning:
         return f"{self.path}:{self.line}: {self.severity}: {self.message}"
 
 
+class Deferred(Sequence[T], Generic[T]):
+    """An immutable sequence whose items are made when first read.
+
+    Decoded facts hold their statements this way: a diff reads the statements of the files
+    that changed, and of few others, so the rest stay compact bytes (docs/performance.md).
+    It equals, and hashes as, the tuple of its items.
+    """
+
+    __slots__ = ("_items", "_length", "_make")
+
+    def __init__(self, length: int, make: Callable[[], tuple[T, ...]]):
+        self._length = length
+        self._make: Callable[[], tuple[T, ...]] | None = make
+        self._items: tuple[T, ...] | None = None
+
+    def items(self) -> tuple[T, ...]:
+        """The items, made on the first call."""
+        if self._items is None:
+            assert self._make is not None
+            items = self._make()
+            if len(items) != self._length:
+                raise ValueError(f"{len(items)} items made, {self._length} announced")
+            self._items, self._make = items, None
+        return self._items
+
+    def __len__(self) -> int:
+        return self._length
+
+    @overload
+    def __getitem__(self, index: int) -> T: ...
+    @overload
+    def __getitem__(self, index: slice) -> tuple[T, ...]: ...
+    def __getitem__(self, index: int | slice) -> T | tuple[T, ...]:
+        return self.items()[index]
+
+    def __iter__(self) -> Iterator[T]:
+        return iter(self.items())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Deferred):
+            return self is other or self.items() == other.items()
+        return isinstance(other, tuple) and self.items() == other
+
+    def __hash__(self) -> int:
+        return hash(self.items())
+
+    def __repr__(self) -> str:
+        return repr(self.items())
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (tuple, (self.items(),))
+
+
 @dataclass(frozen=True, slots=True)
 class FileFacts:
-    """Everything archmetrics knows about one file version."""
+    """Everything archmetrics knows about one file version.
+
+    ``statements`` is a tuple from a parser, a :class:`Deferred` from the cache."""
 
     path: str
     language: str
-    statements: tuple[Statement, ...] = ()
+    statements: Sequence[Statement] = ()
     functions: tuple[Function, ...] = ()
     classes: tuple[Class, ...] = ()
     dependencies: tuple[Dependency, ...] = ()

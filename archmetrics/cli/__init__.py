@@ -21,6 +21,7 @@ from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
 from archmetrics.parsers import UnknownLanguage
 from archmetrics.sources import SourceError
+from archmetrics.sources.codec import CodecError
 from archmetrics.study.manifest import ManifestError
 
 COMMANDS = {
@@ -76,6 +77,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return COMMANDS[args.command](args)
     except CANNOT_MEASURE as error:
         print(f"archmetrics: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    except CodecError as error:  # statements are decoded when first read, after the checks
+        print(
+            f"archmetrics: error: {error}; `archmetrics cache clear` empties the cache",
+            file=sys.stderr,
+        )
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("archmetrics: interrupted", file=sys.stderr)

@@ -10,15 +10,10 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from archmetrics.coupling.imports import dotted
-from archmetrics.facts import Statement
+from archmetrics.facts import Dependency
 
 
-def _clauses(text: str) -> list[list[str]]:
-    inner = text.replace("(", " ").replace(")", " ").replace("\\", " ")
-    return [clause.split() for clause in inner.split(",") if clause.strip()]
-
-
-def module_bindings(statements: Iterable[Statement], modules: Iterable[str]) -> frozenset[str]:
+def module_bindings(dependencies: Iterable[Dependency], modules: Iterable[str]) -> frozenset[str]:
     """Local names bound to modules: every ``import`` name, and ``from`` names in ``modules``.
 
     ``modules`` are the dotted names (as written, relative ones with their dots) this file's
@@ -26,16 +21,12 @@ def module_bindings(statements: Iterable[Statement], modules: Iterable[str]) -> 
     """
     known = set(modules)
     bound: set[str] = set()
-    for statement in statements:
-        text = statement.text
-        if text.startswith("import "):
-            for words in _clauses(text[len("import ") :]):
-                name = "".join(words[: words.index("as")] if "as" in words else words)
-                bound.add(words[-1] if "as" in words else name.split(".")[0])
-        elif text.startswith("from ") and " import " in text:
-            source, _, names = text[len("from ") :].partition(" import ")
-            origin = source.replace(" ", "")
-            for words in _clauses(names):
-                if dotted(origin, words[0]) in known:
-                    bound.add(words[-1])
+    for dependency in dependencies:
+        if not dependency.names:  # import a.b [as c]
+            bound.update(dependency.bound)
+            continue
+        origin = "." * dependency.level + dependency.target
+        for name, local in zip(dependency.names, dependency.bound, strict=False):
+            if dotted(origin, name) in known:
+                bound.add(local)
     return frozenset(bound)

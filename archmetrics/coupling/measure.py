@@ -115,8 +115,7 @@ def _element_sites(
         visible = {d.target for p in (*seen, *element.files) for d in by_path[p].dependencies}
         submodules = [o.name for o in occurrences.get(path, ()) if o.target_file]
         python = facts.language == Language.PYTHON
-        # import bindings are Python's; a C file's statements need not be read for them
-        modules = module_bindings(facts.statements, submodules) if python else frozenset()
+        modules = module_bindings(facts.dependencies, submodules) if python else frozenset()
         tracer = Tracer(facts, lookup, modules)
         found.extend(file_link_sites(facts, rules, sorted(visible), tracer.read, modules))
     return tuple(found)

@@ -132,12 +132,18 @@ class _Reader(ExpressionReader):
     def imports(self, node: ast.Import | ast.ImportFrom, span: Span) -> None:
         if type(node) is ast.Import:
             for alias in node.names:
-                self.dependencies.append(Dependency(alias.name, DependencyKind.IMPORT, span))
+                local = alias.asname or alias.name.split(".")[0]
+                self.dependencies.append(
+                    Dependency(alias.name, DependencyKind.IMPORT, span, bound=(local,))
+                )
             return
         names = tuple(alias.name for alias in node.names)
+        bound = tuple(alias.asname or alias.name for alias in node.names)
         level = node.level or 0  # type: ignore[union-attr]
         module = node.module or ""  # type: ignore[union-attr]
-        self.dependencies.append(Dependency(module, DependencyKind.IMPORT, span, level, names))
+        self.dependencies.append(
+            Dependency(module, DependencyKind.IMPORT, span, level, names, bound)
+        )
 
     # -- compound statements ----------------------------------------------------------------
     def header(self, kind: str, first: int, after: int, target: Frame | None) -> None:

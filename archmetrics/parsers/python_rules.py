@@ -147,17 +147,21 @@ def _plain_fstring(node: cst.FormattedString) -> tuple[bool, Literal]:
 def dependencies(node: cst.CSTNode, span: Span) -> list[Dependency]:
     """The static dependencies one import statement declares."""
     if isinstance(node, cst.Import) or (_LAZY_IMPORT and isinstance(node, _LAZY_IMPORT)):
-        return [
-            Dependency(dotted(alias.name) or "", DependencyKind.IMPORT, span)
-            for alias in getattr(node, "names", ())
-        ]
+        found = []
+        for alias in getattr(node, "names", ()):
+            target = dotted(alias.name) or ""
+            local = _alias(alias) or target.split(".")[0]
+            found.append(Dependency(target, DependencyKind.IMPORT, span, bound=(local,)))
+        return found
     module = getattr(node, "module", None)
     names = getattr(node, "names", ())
-    imported = (
-        ("*",)
-        if isinstance(names, cst.ImportStar)
-        else tuple(dotted(alias.name) or "" for alias in names)
-    )
+    bound: tuple[str, ...]
+    if isinstance(names, cst.ImportStar):
+        imported: tuple[str, ...] = ("*",)
+        bound = imported
+    else:
+        imported = tuple(dotted(alias.name) or "" for alias in names)
+        bound = tuple(_alias(alias) or name for alias, name in zip(names, imported, strict=True))
     return [
         Dependency(
             (dotted(module) or "") if module is not None else "",
@@ -165,8 +169,16 @@ def dependencies(node: cst.CSTNode, span: Span) -> list[Dependency]:
             span,
             level=len(getattr(node, "relative", ())),
             names=imported,
+            bound=bound,
         )
     ]
+
+
+def _alias(alias: cst.ImportAlias) -> str | None:
+    """The ``as`` name of an import alias, if it has one."""
+    if alias.asname is None or not isinstance(alias.asname.name, cst.Name):
+        return None
+    return alias.asname.name.value
 
 
 def is_catch_all(case: cst.MatchCase) -> bool:

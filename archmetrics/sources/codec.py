@@ -1,5 +1,12 @@
 """FileFacts to and from compact JSON, for the cache. Never pickle: a cache file is not trusted.
 
+An entry is two JSON documents on two lines: everything but the statements, then the
+statements. ``decode`` reads the first and leaves the second as bytes until the statements
+are first read (:class:`~archmetrics.facts.Deferred`): a diff reads the statements of the
+files that changed and of few others, and decoding them was half of a warm diff's decode
+(docs/performance.md). The first document holds the statements' count and CRC-32, so a
+damaged second line is found at once, like any other damage.
+
 The path is left out, so one entry serves every path that holds the same blob; ``decode``
 puts the reader's path back. Anything malformed raises :class:`CodecError`.
 """
@@ -7,6 +14,7 @@ puts the reader's path back. Anything malformed raises :class:`CodecError`.
 from __future__ import annotations
 
 import json
+import zlib
 from sys import intern
 from typing import Any
 
@@ -15,6 +23,7 @@ from archmetrics.facts import (
     CallSite,
     Class,
     Decision,
+    Deferred,
     Dependency,
     DependencyKind,
     FileFacts,
@@ -25,7 +34,7 @@ from archmetrics.facts import (
     Statement,
 )
 
-FORMAT = 1
+FORMAT = 2
 
 _new = tuple.__new__
 
@@ -38,11 +47,16 @@ def _span(s: Span) -> list[int]:
     return [s.start, s.end]
 
 
+def _json(document: Any) -> bytes:
+    return json.dumps(document, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+
+
 def encode(facts: FileFacts) -> bytes:
+    statements = _json([[s.kind, *_span(s.span), s.text, s.function] for s in facts.statements])
     document = [
         FORMAT,
         facts.language,
-        [[s.kind, *_span(s.span), s.text, s.function] for s in facts.statements],
+        [len(facts.statements), zlib.crc32(statements)],
         [
             [
                 f.name,
@@ -55,7 +69,7 @@ def encode(facts: FileFacts) -> bytes:
         ],
         [[c.name, c.qualified_name, *_span(c.span), c.kind] for c in facts.classes],
         [
-            [d.target, str(d.kind), *_span(d.span), d.level, list(d.names)]
+            [d.target, str(d.kind), *_span(d.span), d.level, list(d.names), list(d.bound)]
             for d in facts.dependencies
         ],
         [
@@ -74,14 +88,40 @@ def encode(facts: FileFacts) -> bytes:
         facts.parsed,
         facts.generated,
     ]
-    return json.dumps(document, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+    return _json(document) + b"\n" + statements  # JSON escapes newlines inside strings
 
 
-def _decode(document: Any, path: str) -> FileFacts:
+def _statements(data: bytes, count: int, path: str) -> tuple[Statement, ...]:
+    """The statements of an entry, decoded when first read."""
+    spans: dict[tuple[int, int], Span] = {}
+    known = spans.get
+    try:
+        made = tuple(
+            [
+                _new(
+                    Statement,
+                    (
+                        intern(k),
+                        known((a, b)) or spans.setdefault((a, b), Span(a, b)),
+                        intern(t),
+                        fn and intern(fn),
+                    ),
+                )
+                for k, a, b, t, fn in json.loads(data)
+            ]
+        )
+    except (ValueError, TypeError) as error:
+        raise CodecError(f"bad statements in the cached facts of {path}: {error}") from error
+    if len(made) != count:
+        raise CodecError(f"{len(made)} statements in the cached facts of {path}, not {count}")
+    return made
+
+
+def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
     (
         fmt,
         language,
-        statements,
+        (count, checksum),
         functions,
         classes,
         deps,
@@ -93,6 +133,8 @@ def _decode(document: Any, path: str) -> FileFacts:
     ) = document
     if fmt != FORMAT:
         raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
+    if zlib.crc32(statements) != checksum or type(count) is not int:
+        raise CodecError("the statements do not match their checksum")
     spans: dict[tuple[int, int], Span] = {}
     known = spans.get  # `known((a, b)) or span(a, b)`: only a C call for a range seen before
 
@@ -118,15 +160,7 @@ def _decode(document: Any, path: str) -> FileFacts:
     return FileFacts(
         path=path,
         language=intern(language),
-        statements=tuple(
-            [
-                _new(
-                    Statement,
-                    (intern(k), known((a, b)) or span(a, b), intern(t), fn and intern(fn)),
-                )
-                for k, a, b, t, fn in statements
-            ]
-        ),
+        statements=Deferred(count, lambda: _statements(statements, count, path)),
         functions=tuple(
             [
                 _new(
@@ -145,8 +179,10 @@ def _decode(document: Any, path: str) -> FileFacts:
         classes=tuple([Class(n, q, known((a, b)) or span(a, b), k) for n, q, a, b, k in classes]),
         dependencies=tuple(
             [
-                Dependency(t, DependencyKind(k), known((a, b)) or span(a, b), lv, tuple(ns))
-                for t, k, a, b, lv, ns in deps
+                Dependency(
+                    t, DependencyKind(k), known((a, b)) or span(a, b), lv, tuple(ns), tuple(bn)
+                )
+                for t, k, a, b, lv, ns, bn in deps
             ]
         ),
         call_sites=tuple(
@@ -174,8 +210,11 @@ def _decode(document: Any, path: str) -> FileFacts:
 
 def decode(data: bytes, path: str) -> FileFacts:
     """The facts ``encode`` wrote, now at ``path``; CodecError for anything else."""
+    head, newline, statements = data.partition(b"\n")
+    if not newline:
+        raise CodecError("not a facts record: no statements line")
     try:
-        return _decode(json.loads(data), path)
+        return _decode(json.loads(head), statements, path)
     except CodecError:
         raise
     except (ValueError, TypeError, KeyError) as error:

@@ -7,6 +7,9 @@ starts calling a new store module (new).
 from __future__ import annotations
 
 import json
+import sqlite3
+import zlib
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -267,3 +270,33 @@ def test_formats(
         == 0
     )
     assert needle in capsys.readouterr().out
+
+
+def test_damaged_statements_in_the_cache_are_a_one_line_error(
+    integration: GitRepo, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    cache = tmp_path / "facts.sqlite3"
+    first = diff(integration, capsys, "--base", "v1", "--head", "v2", "--cache-path", str(cache))
+    db = sqlite3.connect(cache)
+    for rowid, data in db.execute("select rowid, data from facts").fetchall():
+        head, statements = data.split(b"\n", 1)
+        bad = statements.replace(b'"import"', b"1")  # well-formed JSON, not statements
+        document = json.loads(head)
+        document[2][1] = zlib.crc32(bad)  # a checksum that matches: found only when read
+        db.execute("update facts set data=? where rowid=?", (_json(document) + b"\n" + bad, rowid))
+    db.commit()
+    db.close()
+    code = main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2",
+                 "--cache-path", str(cache)])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "bad statements in the cached facts of app/client.py" in err
+    assert "archmetrics cache clear" in err
+    main(["cache", "clear", "--cache-path", str(cache)])
+    capsys.readouterr()
+    again = diff(integration, capsys, "--base", "v1", "--head", "v2", "--cache-path", str(cache))
+    assert again == first
+
+
+def _json(document: Any) -> bytes:
+    return json.dumps(document, separators=(",", ":")).encode()

@@ -418,30 +418,36 @@ def test_class_body_inside_a_function_gives_its_decisions_to_no_function() -> No
 # --- dependencies ------------------------------------------------------------------------
 
 
-def deps(source: str) -> list[tuple[str, int, tuple[str, ...]]]:
-    return [(d.target, d.level, d.names) for d in py(source).dependencies]
+Imported = tuple[str, int, tuple[str, ...], tuple[str, ...]]
+
+
+def deps(source: str) -> list[Imported]:
+    return [(d.target, d.level, d.names, d.bound) for d in py(source).dependencies]
 
 
 def test_import_gives_one_dependency_per_module() -> None:
-    facts = py("import a.b as c, d\n")
+    facts = py("import a.b as c, d.e\n")
     assert facts.dependencies == (
-        Dependency("a.b", DependencyKind.IMPORT, Span(1, 1)),
-        Dependency("d", DependencyKind.IMPORT, Span(1, 1)),
+        Dependency("a.b", DependencyKind.IMPORT, Span(1, 1), bound=("c",)),
+        Dependency("d.e", DependencyKind.IMPORT, Span(1, 1), bound=("d",)),
     )
 
 
 @pytest.mark.parametrize(
     ("source", "expected"),
     [
-        ("from x.y import p, q as r", [("x.y", 0, ("p", "q"))]),
-        ("from ..m import n", [("m", 2, ("n",))]),
-        ("from . import m", [("", 1, ("m",))]),
-        ("from x import *", [("x", 0, ("*",))]),
-        ("from __future__ import annotations", [("__future__", 0, ("annotations",))]),
-        ("from .a.b import (c,\n    d)", [("a.b", 1, ("c", "d"))]),
+        ("from x.y import p, q as r", [("x.y", 0, ("p", "q"), ("p", "r"))]),
+        ("from ..m import n", [("m", 2, ("n",), ("n",))]),
+        ("from . import m", [("", 1, ("m",), ("m",))]),
+        ("from x import *", [("x", 0, ("*",), ("*",))]),
+        (
+            "from __future__ import annotations",
+            [("__future__", 0, ("annotations",), ("annotations",))],
+        ),
+        ("from .a.b import (c,\n    d as e)", [("a.b", 1, ("c", "d"), ("c", "e"))]),
     ],
 )
-def test_from_import_forms(source: str, expected: list[tuple[str, int, tuple[str, ...]]]) -> None:
+def test_from_import_forms(source: str, expected: list[Imported]) -> None:
     assert deps(source + "\n") == expected
 
 

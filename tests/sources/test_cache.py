@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+import zlib
 from pathlib import Path
 
 import pytest
@@ -13,6 +14,7 @@ from archmetrics.facts import (
     CallSite,
     Class,
     Decision,
+    Deferred,
     Dependency,
     DependencyKind,
     FileFacts,
@@ -36,7 +38,7 @@ SAMPLE = FileFacts(
     ),
     functions=(Function("f", "f", Span(3, 5), (Decision("if", 4), Decision("and", 4)), 3),),
     classes=(Class("C", "C", Span(6, 9), "class"),),
-    dependencies=(Dependency("", DependencyKind.IMPORT, Span(1, 1), 2, ("m", "n")),),
+    dependencies=(Dependency("", DependencyKind.IMPORT, Span(1, 1), 2, ("m", "n"), ("m", "o")),),
     call_sites=(
         CallSite(
             "bus.request",
@@ -93,22 +95,47 @@ def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types
     assert first.statements[1].text is again.statements[1].text  # texts are interned
 
 
+def _parts() -> tuple[list[object], bytes]:
+    head, statements = codec.encode(SAMPLE).split(b"\n", 1)
+    return json.loads(head), statements
+
+
 def _tampered(edit: str) -> bytes:
-    document = json.loads(codec.encode(SAMPLE))
-    if edit == "span":
-        document[2][0][1] = 0  # a statement starting on line 0
+    document, statements = _parts()
+    if edit == "statement":  # a statement starting on line 0, the checksum left as it was
+        statements = statements.replace(b'"assign",1,2', b'"assign",0,2')
     else:
-        document[6][0][6][0] = ["x", None]  # an argument with two fields of four
-    return json.dumps(document).encode()
+        document[6][0][6][0] = ["x", None]  # type: ignore[index]  # an argument with two fields
+    return json.dumps(document).encode() + b"\n" + statements
 
 
-@pytest.mark.parametrize("edit", ["span", "argument"])
+@pytest.mark.parametrize("edit", ["statement", "argument"])
 def test_codec_rejects_tampered_records(edit: str) -> None:
     with pytest.raises(codec.CodecError):
         codec.decode(_tampered(edit), "x.py")
 
 
-@pytest.mark.parametrize("bad", [b"", b"[]", b"{}", b"[2]", b"not json", b'[1, "python"]'])
+def test_statements_are_decoded_when_first_read() -> None:
+    facts = codec.decode(codec.encode(SAMPLE), "a/b.py")
+    assert isinstance(facts.statements, Deferred)
+    assert facts.loc == 2  # counted without decoding them
+    assert facts.statements[1].text == "def f ( ) :"
+    assert facts.statements == SAMPLE.statements and facts == SAMPLE
+
+
+def test_statements_damaged_behind_a_good_checksum_fail_when_read() -> None:
+    document, statements = _parts()
+    bad = statements.replace(b'"assign",1,2', b'"assign",0,2')
+    document[2][1] = zlib.crc32(bad)  # type: ignore[index]
+    facts = codec.decode(json.dumps(document).encode() + b"\n" + bad, "x.py")
+    assert facts.loc == 2
+    with pytest.raises(codec.CodecError, match=r"x\.py"):
+        facts.statements[0]
+
+
+@pytest.mark.parametrize(
+    "bad", [b"", b"[]", b"{}", b"[2]\n[]", b"not json", b'[2, "python"]\n[]', b"\n"]
+)
 def test_codec_rejects_what_it_did_not_write(bad: bytes) -> None:
     with pytest.raises(codec.CodecError):
         codec.decode(bad, "x.py")
