@@ -171,17 +171,24 @@ class ParseWarning:
 class Deferred(Sequence[T], Generic[T]):
     """An immutable sequence whose items are made when first read.
 
-    Decoded facts hold their statements this way: a diff reads the statements of the files
-    that changed, and of few others, so the rest stay compact bytes (docs/performance.md).
-    It equals, and hashes as, the tuple of its items.
+    Decoded facts hold their statements and call sites this way: a diff reads the statements
+    of the files that changed, and coupling the call sites of the files where a rule names a
+    callee, so the rest stay compact bytes (docs/performance.md). It equals, and hashes as,
+    the tuple of its items.
     """
 
-    __slots__ = ("_items", "_length", "_make")
+    __slots__ = ("_items", "_length", "_make", "keys")
 
-    def __init__(self, length: int, make: Callable[[], tuple[T, ...]]):
+    def __init__(
+        self,
+        length: int,
+        make: Callable[[], tuple[T, ...]],
+        keys: frozenset[str] | None = None,
+    ):
         self._length = length
         self._make: Callable[[], tuple[T, ...]] | None = make
         self._items: tuple[T, ...] | None = None
+        self.keys = keys  # what the maker kept readable without making the items, if anything
 
     def items(self) -> tuple[T, ...]:
         """The items, made on the first call."""
@@ -225,7 +232,8 @@ class Deferred(Sequence[T], Generic[T]):
 class FileFacts:
     """Everything archmetrics knows about one file version.
 
-    ``statements`` is a tuple from a parser, a :class:`Deferred` from the cache."""
+    ``statements`` and ``call_sites`` are tuples from a parser, :class:`Deferred` from the
+    cache."""
 
     path: str
     language: str
@@ -233,11 +241,18 @@ class FileFacts:
     functions: tuple[Function, ...] = ()
     classes: tuple[Class, ...] = ()
     dependencies: tuple[Dependency, ...] = ()
-    call_sites: tuple[CallSite, ...] = ()
+    call_sites: Sequence[CallSite] = ()
     sloc: int = 0  # physical lines that are neither blank nor only comment
     warnings: tuple[ParseWarning, ...] = ()
     parsed: bool = True  # False: the parser could not read it at all (reported, not guessed)
     generated: bool = False  # the file declares itself generated ("@generated", "DO NOT EDIT")
+
+    def callees(self) -> frozenset[str]:
+        """The callees of the file's call sites (read without decoding them, if cached)."""
+        sites = self.call_sites
+        if isinstance(sites, Deferred) and sites.keys is not None:
+            return sites.keys
+        return frozenset(call.callee for call in sites)
 
     @property
     def loc(self) -> int:

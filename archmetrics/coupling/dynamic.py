@@ -234,7 +234,9 @@ def file_link_sites(
     ]  # fmt: skip
     calls = rule_index(tuple(r for r in usable if r.site is SiteKind.CALL))
     found: list[tuple[Rule, LinkSite]] = []
-    for call in facts.call_sites:
+    # a file none of whose callees a rule names has no call site to read (nor to decode)
+    readable = facts.call_sites if any(map(calls.choose, facts.callees())) else ()
+    for call in readable:
         receiver = normalize_callee(call.receiver) if call.receiver else None
         rule = calls.choose(call.callee, receiver in modules)
         if rule and not (rule.unless_from and _assigned_from(facts, call, rule.unless_from)):

@@ -1,11 +1,12 @@
 """FileFacts to and from compact JSON, for the cache. Never pickle: a cache file is not trusted.
 
-An entry is two JSON documents on two lines: everything but the statements, then the
-statements. ``decode`` reads the first and leaves the second as bytes until the statements
-are first read (:class:`~archmetrics.facts.Deferred`): a diff reads the statements of the
-files that changed and of few others, and decoding them was half of a warm diff's decode
-(docs/performance.md). The first document holds the statements' count and CRC-32, so a
-damaged second line is found at once, like any other damage.
+An entry is three JSON documents on three lines: everything but the call sites and the
+statements, then the call sites, then the statements. ``decode`` reads the first and leaves
+the others as bytes until first read (:class:`~archmetrics.facts.Deferred`): a diff reads
+the statements of the files that changed, and coupling the call sites of files where a rule
+names one of their callees, and building those records was most of a warm diff's decode
+(docs/performance.md). The first document holds the count and CRC-32 of each of the other
+two (so damage to them is found at once, like any other damage) and the file's callees.
 
 The path is left out, so one entry serves every path that holds the same blob; ``decode``
 puts the reader's path back. Anything malformed raises :class:`CodecError`.
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import json
 import zlib
+from collections.abc import Callable
 from sys import intern
 from typing import Any
 
@@ -34,7 +36,7 @@ from archmetrics.facts import (
     Statement,
 )
 
-FORMAT = 2
+FORMAT = 3
 
 _new = tuple.__new__
 
@@ -53,10 +55,24 @@ def _json(document: Any) -> bytes:
 
 def encode(facts: FileFacts) -> bytes:
     statements = _json([[s.kind, *_span(s.span), s.text, s.function] for s in facts.statements])
+    calls = _json(
+        [
+            [
+                c.callee,
+                c.name,
+                c.receiver,
+                *_span(c.span),
+                c.function,
+                [[a.text, a.value, a.is_literal, a.keyword] for a in c.arguments],
+            ]
+            for c in facts.call_sites
+        ]
+    )
     document = [
         FORMAT,
         facts.language,
         [len(facts.statements), zlib.crc32(statements)],
+        [len(facts.call_sites), zlib.crc32(calls), sorted(facts.callees())],
         [
             [
                 f.name,
@@ -72,77 +88,63 @@ def encode(facts: FileFacts) -> bytes:
             [d.target, str(d.kind), *_span(d.span), d.level, list(d.names), list(d.bound)]
             for d in facts.dependencies
         ],
-        [
-            [
-                c.callee,
-                c.name,
-                c.receiver,
-                *_span(c.span),
-                c.function,
-                [[a.text, a.value, a.is_literal, a.keyword] for a in c.arguments],
-            ]
-            for c in facts.call_sites
-        ],
         facts.sloc,
         [[w.line, w.message, str(w.severity)] for w in facts.warnings],
         facts.parsed,
         facts.generated,
     ]
-    return _json(document) + b"\n" + statements  # JSON escapes newlines inside strings
+    # three lines: JSON escapes the newlines inside strings
+    return b"\n".join((_json(document), calls, statements))
 
 
-def _statements(data: bytes, count: int, path: str) -> tuple[Statement, ...]:
-    """The statements of an entry, decoded when first read."""
-    spans: dict[tuple[int, int], Span] = {}
-    known = spans.get
-    try:
-        made = tuple(
-            [
-                _new(
-                    Statement,
-                    (
-                        intern(k),
-                        known((a, b)) or spans.setdefault((a, b), Span(a, b)),
-                        intern(t),
-                        fn and intern(fn),
-                    ),
-                )
-                for k, a, b, t, fn in json.loads(data)
-            ]
-        )
-    except (ValueError, TypeError) as error:
-        raise CodecError(f"bad statements in the cached facts of {path}: {error}") from error
-    if len(made) != count:
-        raise CodecError(f"{len(made)} statements in the cached facts of {path}, not {count}")
-    return made
+class _Spans(dict[tuple[int, int], Span]):
+    """One Span object per line range: records on a line share it."""
 
-
-def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
-    (
-        fmt,
-        language,
-        (count, checksum),
-        functions,
-        classes,
-        deps,
-        calls,
-        sloc,
-        warnings,
-        parsed,
-        generated,
-    ) = document
-    if fmt != FORMAT:
-        raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
-    if zlib.crc32(statements) != checksum or type(count) is not int:
-        raise CodecError("the statements do not match their checksum")
-    spans: dict[tuple[int, int], Span] = {}
-    known = spans.get  # `known((a, b)) or span(a, b)`: only a C call for a range seen before
-
-    def span(a: int, b: int) -> Span:
-        """One Span object per line range: statements and calls on a line share it."""
-        made = spans[(a, b)] = Span(a, b)  # checks the range: the bytes are not trusted
+    def __missing__(self, key: tuple[int, int]) -> Span:
+        made = self[key] = Span(*key)  # checks the range: the bytes are not trusted
         return made
 
+
+def _deferred(
+    data: bytes,
+    count: Any,
+    checksum: Any,
+    what: str,
+    path: str,
+    make: Callable[[Any], list[Any]],
+    keys: frozenset[str] | None = None,
+) -> Deferred[Any]:
+    """Records left as bytes until first read; their count and checksum are checked now."""
+    if type(count) is not int or zlib.crc32(data) != checksum:
+        raise CodecError(f"the {what} do not match their checksum")
+
+    def made() -> tuple[Any, ...]:
+        try:
+            records = make(json.loads(data))
+        except (ValueError, TypeError) as error:
+            raise CodecError(f"bad {what} in the cached facts of {path}: {error}") from error
+        if len(records) != count:
+            raise CodecError(f"{len(records)} {what} in the cached facts of {path}, not {count}")
+        return tuple(records)
+
+    return Deferred(count, made, keys)
+
+
+# The records are named tuples, built by tuple's own constructor (their fields are unpacked
+# first, so a record of the wrong length still fails); optional names are None or a string,
+# and ``x and intern(x)`` keeps None as None.
+
+
+def _statements(rows: list[list[Any]]) -> list[Statement]:
+    spans = _Spans()
+    return [
+        _new(Statement, (intern(k), spans[a, b], intern(t), fn and intern(fn)))
+        for k, a, b, t, fn in rows
+    ]
+
+
+def _calls(rows: list[list[Any]]) -> list[CallSite]:
+    spans = _Spans()
     lists: dict[tuple[Argument, ...], tuple[Argument, ...]] = {}
 
     def arguments(args: list[list[Any]]) -> tuple[Argument, ...]:
@@ -154,13 +156,45 @@ def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
         made = tuple([_new(Argument, (intern(t), v, lit, kw)) for t, v, lit, kw in args])
         return lists.setdefault(made, made)
 
-    # The records are named tuples, built here by tuple's own constructor (their fields are
-    # unpacked above it, so a record of the wrong length still fails); optional names are
-    # None or a string, and ``x and intern(x)`` keeps None as None.
+    return [
+        _new(
+            CallSite,
+            (
+                intern(callee),
+                intern(call),
+                recv and intern(recv),
+                spans[a, b],
+                arguments(args),
+                fn and intern(fn),
+            ),
+        )
+        for callee, call, recv, a, b, fn, args in rows
+    ]
+
+
+def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFacts:
+    (
+        fmt,
+        language,
+        (statement_count, statement_checksum),
+        (call_count, call_checksum, callees),
+        functions,
+        classes,
+        deps,
+        sloc,
+        warnings,
+        parsed,
+        generated,
+    ) = document
+    if fmt != FORMAT:
+        raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
+    spans = _Spans()
     return FileFacts(
         path=path,
         language=intern(language),
-        statements=Deferred(count, lambda: _statements(statements, count, path)),
+        statements=_deferred(
+            statements, statement_count, statement_checksum, "statements", path, _statements
+        ),
         functions=tuple(
             [
                 _new(
@@ -168,7 +202,7 @@ def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
                     (
                         n,
                         q,
-                        known((a, b)) or span(a, b),
+                        spans[a, b],
                         tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
                         st,
                     ),
@@ -176,30 +210,21 @@ def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
                 for n, q, a, b, st, ds in functions
             ]
         ),
-        classes=tuple([Class(n, q, known((a, b)) or span(a, b), k) for n, q, a, b, k in classes]),
+        classes=tuple([Class(n, q, spans[a, b], k) for n, q, a, b, k in classes]),
         dependencies=tuple(
             [
-                Dependency(
-                    t, DependencyKind(k), known((a, b)) or span(a, b), lv, tuple(ns), tuple(bn)
-                )
+                Dependency(t, DependencyKind(k), spans[a, b], lv, tuple(ns), tuple(bn))
                 for t, k, a, b, lv, ns, bn in deps
             ]
         ),
-        call_sites=tuple(
-            [
-                _new(
-                    CallSite,
-                    (
-                        intern(callee),
-                        intern(call),
-                        recv and intern(recv),
-                        known((a, b)) or span(a, b),
-                        arguments(args),
-                        fn and intern(fn),
-                    ),
-                )
-                for callee, call, recv, a, b, fn, args in calls
-            ]
+        call_sites=_deferred(
+            calls,
+            call_count,
+            call_checksum,
+            "call sites",
+            path,
+            _calls,
+            frozenset(intern(callee) for callee in callees),
         ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
@@ -210,11 +235,11 @@ def _decode(document: Any, statements: bytes, path: str) -> FileFacts:
 
 def decode(data: bytes, path: str) -> FileFacts:
     """The facts ``encode`` wrote, now at ``path``; CodecError for anything else."""
-    head, newline, statements = data.partition(b"\n")
-    if not newline:
-        raise CodecError("not a facts record: no statements line")
+    lines = data.split(b"\n", 2)
+    if len(lines) != 3:
+        raise CodecError("not a facts record: not three lines")
     try:
-        return _decode(json.loads(head), statements, path)
+        return _decode(json.loads(lines[0]), lines[1], lines[2], path)
     except CodecError:
         raise
     except (ValueError, TypeError, KeyError) as error:

@@ -14,6 +14,10 @@ from archmetrics.sources.snapshot import DirectorySnapshot
 from tests.gitrepo import GitRepo
 
 PY = "def f{i}(a):\n    if a > {i}:\n        return [x for x in a if x]\n    return None\n"
+CLIENT = (
+    'import zmq\n\nsock = zmq.Context().socket(zmq.REQ)\nsock.connect("tcp://localhost:5555")\n'
+)
+SERVER = 'import zmq\n\nsock = zmq.Context().socket(zmq.REP)\nsock.bind("tcp://*:5555")\n'
 C = "int g{i}(int a) {{\n    switch (a) {{ case {i}: return 1; default: return a && {i}; }}\n}}\n"
 
 
@@ -82,6 +86,9 @@ def test_a_diff_is_the_same_without_cache_cold_and_warm(repo: GitRepo, tmp_path:
             for i in range(PARALLEL_THRESHOLD)
         }
         files["src/broken.py"] = "def broken(:\n    pass\n"
+        # a run-time link: dynamic coupling reads these call sites, decoded or parsed
+        files["src/client.py"] = CLIENT + change
+        files["src/server.py"] = SERVER
         return files
 
     repo.commit("one", tag="v1", files=tree())
@@ -108,5 +115,7 @@ def test_a_diff_is_the_same_without_cache_cold_and_warm(repo: GitRepo, tmp_path:
         return json.loads(out.read_text())
 
     plain = run("--no-cache")
+    client = next(e for e in plain["elements"] if e["element"] == "src/client.py")  # type: ignore[index]
+    assert client["post"]["d_e"] == 1  # the link is there to be found
     assert run(*cache) == plain  # cold
     assert run(*cache) == plain  # warm

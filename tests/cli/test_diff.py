@@ -279,11 +279,12 @@ def test_damaged_statements_in_the_cache_are_a_one_line_error(
     first = diff(integration, capsys, "--base", "v1", "--head", "v2", "--cache-path", str(cache))
     db = sqlite3.connect(cache)
     for rowid, data in db.execute("select rowid, data from facts").fetchall():
-        head, statements = data.split(b"\n", 1)
+        head, calls, statements = data.split(b"\n")
         bad = statements.replace(b'"import"', b"1")  # well-formed JSON, not statements
         document = json.loads(head)
         document[2][1] = zlib.crc32(bad)  # a checksum that matches: found only when read
-        db.execute("update facts set data=? where rowid=?", (_json(document) + b"\n" + bad, rowid))
+        damaged = b"\n".join((_json(document), calls, bad))
+        db.execute("update facts set data=? where rowid=?", (damaged, rowid))
     db.commit()
     db.close()
     code = main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2",

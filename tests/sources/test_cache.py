@@ -6,6 +6,7 @@ import json
 import sqlite3
 import zlib
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -95,46 +96,60 @@ def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types
     assert first.statements[1].text is again.statements[1].text  # texts are interned
 
 
-def _parts() -> tuple[list[object], bytes]:
-    head, statements = codec.encode(SAMPLE).split(b"\n", 1)
-    return json.loads(head), statements
+def _parts() -> tuple[list[Any], bytes, bytes]:
+    head, calls, statements = codec.encode(SAMPLE).split(b"\n")
+    return json.loads(head), calls, statements
+
+
+def _joined(document: list[Any], calls: bytes, statements: bytes) -> bytes:
+    return b"\n".join((json.dumps(document).encode(), calls, statements))
 
 
 def _tampered(edit: str) -> bytes:
-    document, statements = _parts()
+    document, calls, statements = _parts()
     if edit == "statement":  # a statement starting on line 0, the checksum left as it was
         statements = statements.replace(b'"assign",1,2', b'"assign",0,2')
+    elif edit == "call":  # an argument with two fields of four
+        calls = calls.replace(b'["x",null,false,"timeout"]', b'["x",null]')
     else:
-        document[6][0][6][0] = ["x", None]  # type: ignore[index]  # an argument with two fields
-    return json.dumps(document).encode() + b"\n" + statements
+        document[4][0][2] = 0  # a function starting on line 0
+    return _joined(document, calls, statements)
 
 
-@pytest.mark.parametrize("edit", ["statement", "argument"])
+@pytest.mark.parametrize("edit", ["statement", "call", "function"])
 def test_codec_rejects_tampered_records(edit: str) -> None:
+    assert _tampered(edit) != codec.encode(SAMPLE)
     with pytest.raises(codec.CodecError):
         codec.decode(_tampered(edit), "x.py")
 
 
-def test_statements_are_decoded_when_first_read() -> None:
+def test_statements_and_calls_are_decoded_when_first_read() -> None:
     facts = codec.decode(codec.encode(SAMPLE), "a/b.py")
-    assert isinstance(facts.statements, Deferred)
+    assert isinstance(facts.statements, Deferred) and isinstance(facts.call_sites, Deferred)
     assert facts.loc == 2  # counted without decoding them
+    assert facts.callees() == {"bus.request"}  # kept readable without decoding the calls
     assert facts.statements[1].text == "def f ( ) :"
+    assert facts.call_sites[0].arguments[1].keyword == "timeout"
     assert facts.statements == SAMPLE.statements and facts == SAMPLE
 
 
-def test_statements_damaged_behind_a_good_checksum_fail_when_read() -> None:
-    document, statements = _parts()
-    bad = statements.replace(b'"assign",1,2', b'"assign",0,2')
-    document[2][1] = zlib.crc32(bad)  # type: ignore[index]
-    facts = codec.decode(json.dumps(document).encode() + b"\n" + bad, "x.py")
-    assert facts.loc == 2
-    with pytest.raises(codec.CodecError, match=r"x\.py"):
-        facts.statements[0]
+@pytest.mark.parametrize("part", ["statements", "call sites"])
+def test_records_damaged_behind_a_good_checksum_fail_when_read(part: str) -> None:
+    document, calls, statements = _parts()
+    if part == "statements":
+        statements = statements.replace(b'"assign",1,2', b'"assign",0,2')
+        document[2][1] = zlib.crc32(statements)
+    else:
+        calls = calls.replace(b'"bus.request","request"', b'"bus.request",7')
+        document[3][1] = zlib.crc32(calls)
+    facts = codec.decode(_joined(document, calls, statements), "x.py")
+    assert facts.loc == 2 and len(facts.call_sites) == 1
+    with pytest.raises(codec.CodecError, match=rf"bad {part} in the cached facts of x\.py"):
+        list(facts.statements if part == "statements" else facts.call_sites)
 
 
 @pytest.mark.parametrize(
-    "bad", [b"", b"[]", b"{}", b"[2]\n[]", b"not json", b'[2, "python"]\n[]', b"\n"]
+    "bad", [b"", b"[]", b"{}", b"[3]\n[]\n[]", b"not json", b'[3, "python"]\n[]\n[]', b"\n\n"]
 )
 def test_codec_rejects_what_it_did_not_write(bad: bytes) -> None:
     with pytest.raises(codec.CodecError):
