@@ -14,7 +14,8 @@ docs/performance.md has the figures. Compare them only with records of their own
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+import hashlib
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Generic, NamedTuple, TypeVar, overload
@@ -177,18 +178,22 @@ class Deferred(Sequence[T], Generic[T]):
     the tuple of its items.
     """
 
-    __slots__ = ("_items", "_length", "_make", "keys")
+    __slots__ = ("_items", "_length", "_make", "digest", "keys")
 
     def __init__(
         self,
         length: int,
         make: Callable[[], tuple[T, ...]],
         keys: frozenset[str] | None = None,
+        digest: str | None = None,
     ):
         self._length = length
         self._make: Callable[[], tuple[T, ...]] | None = make
         self._items: tuple[T, ...] | None = None
-        self.keys = keys  # what the maker kept readable without making the items, if anything
+        # what the maker kept readable without making the items: call sites keep their
+        # callees (``keys``), statements the digest of their kinds and texts (``digest``)
+        self.keys = keys
+        self.digest = digest
 
     def items(self) -> tuple[T, ...]:
         """The items, made on the first call."""
@@ -226,6 +231,22 @@ class Deferred(Sequence[T], Generic[T]):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (tuple, (self.items(),))
+
+
+def statements_digest(statements: Iterable[Statement]) -> str:
+    """A digest of the kinds and texts of ``statements``, in order: two sequences with the
+    same digest have the same statements but for their lines."""
+    digest = hashlib.blake2b(digest_size=16)
+    for statement in statements:
+        kind, text = statement.kind.encode(), statement.text.encode()
+        digest.update(b"%d:%s%d:%s" % (len(kind), kind, len(text), text))
+    return digest.hexdigest()
+
+
+def kept_digest(statements: Sequence[Statement]) -> str | None:
+    """The digest the cache kept of a statement sequence, without decoding it; None when
+    the sequence came from a parser."""
+    return statements.digest if isinstance(statements, Deferred) else None
 
 
 @dataclass(frozen=True, slots=True)

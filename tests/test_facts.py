@@ -6,7 +6,14 @@ import pickle
 
 import pytest
 
-from archmetrics.facts import Deferred, FileFacts, Span, Statement
+from archmetrics.facts import (
+    Deferred,
+    FileFacts,
+    Span,
+    Statement,
+    kept_digest,
+    statements_digest,
+)
 
 STATEMENTS = (Statement("assign", Span(1, 1), "x = 1"), Statement("pass", Span(2, 2), "pass"))
 
@@ -45,3 +52,14 @@ def test_it_pickles_as_a_plain_tuple() -> None:
 def test_a_wrong_count_is_an_error_not_a_silent_difference() -> None:
     with pytest.raises(ValueError, match="3 announced"):
         Deferred(3, lambda: STATEMENTS)[0]
+
+
+def test_the_statements_digest_sees_kinds_and_texts_not_lines() -> None:
+    moved = tuple(s._replace(span=Span(s.span.start + 5, s.span.end + 5)) for s in STATEMENTS)
+    assert statements_digest(moved) == statements_digest(STATEMENTS)
+    renamed = (STATEMENTS[0]._replace(text="x = 2"), STATEMENTS[1])
+    rekinded = (STATEMENTS[0]._replace(kind="expr"), STATEMENTS[1])
+    digests = {statements_digest(s) for s in (STATEMENTS, renamed, rekinded, STATEMENTS[:1])}
+    assert len(digests) == 4
+    assert kept_digest(STATEMENTS) is None
+    assert kept_digest(Deferred(2, lambda: STATEMENTS, digest="abc")) == "abc"

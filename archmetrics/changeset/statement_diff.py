@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from difflib import SequenceMatcher
 from enum import StrEnum
 
-from archmetrics.facts import FileFacts, Statement
+from archmetrics.facts import FileFacts, Statement, kept_digest
 
 SIMILARITY_THRESHOLD = 0.5
 """Token ratio 2·M/T at or above which two statements of different kinds still pair."""
@@ -215,6 +215,9 @@ def diff_statements(
 ) -> FileChange:
     """Γ_A, Γ_R, Γ_M between two statement sequences of one file, with per-statement detail."""
     if pre is post:  # the cache hands both revisions one object for an unchanged blob
+        return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
+    digest = kept_digest(pre)
+    if digest is not None and digest == kept_digest(post):  # as below, without decoding them
         return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
     pre_keys, post_keys = [_key(s) for s in pre], [_key(s) for s in post]
     if pre_keys == post_keys:  # nothing changed but layout or comments

@@ -6,7 +6,9 @@ the others as bytes until first read (:class:`~archmetrics.facts.Deferred`): a d
 the statements of the files that changed, and coupling the call sites of files where a rule
 names one of their callees, and building those records was most of a warm diff's decode
 (docs/performance.md). The first document holds the count and CRC-32 of each of the other
-two (so damage to them is found at once, like any other damage) and the file's callees.
+two (so damage to them is found at once, like any other damage), the file's callees and the
+digest of its statements' kinds and texts (a file that changed only in layout or comments
+is then found unchanged without decoding its statements).
 
 The path is left out, so one entry serves every path that holds the same blob; ``decode``
 puts the reader's path back. Anything malformed raises :class:`CodecError`.
@@ -34,9 +36,10 @@ from archmetrics.facts import (
     Severity,
     Span,
     Statement,
+    statements_digest,
 )
 
-FORMAT = 3
+FORMAT = 4
 
 _new = tuple.__new__
 
@@ -71,7 +74,7 @@ def encode(facts: FileFacts) -> bytes:
     document = [
         FORMAT,
         facts.language,
-        [len(facts.statements), zlib.crc32(statements)],
+        [len(facts.statements), zlib.crc32(statements), statements_digest(facts.statements)],
         [len(facts.call_sites), zlib.crc32(calls), sorted(facts.callees())],
         [
             [
@@ -113,6 +116,7 @@ def _deferred(
     path: str,
     make: Callable[[Any], list[Any]],
     keys: frozenset[str] | None = None,
+    digest: str | None = None,
 ) -> Deferred[Any]:
     """Records left as bytes until first read; their count and checksum are checked now."""
     if type(count) is not int or zlib.crc32(data) != checksum:
@@ -127,7 +131,7 @@ def _deferred(
             raise CodecError(f"{len(records)} {what} in the cached facts of {path}, not {count}")
         return tuple(records)
 
-    return Deferred(count, made, keys)
+    return Deferred(count, made, keys, digest)
 
 
 # The records are named tuples, built by tuple's own constructor (their fields are unpacked
@@ -176,7 +180,7 @@ def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFa
     (
         fmt,
         language,
-        (statement_count, statement_checksum),
+        (statement_count, statement_checksum, digest),
         (call_count, call_checksum, callees),
         functions,
         classes,
@@ -193,7 +197,13 @@ def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFa
         path=path,
         language=intern(language),
         statements=_deferred(
-            statements, statement_count, statement_checksum, "statements", path, _statements
+            statements,
+            statement_count,
+            statement_checksum,
+            "statements",
+            path,
+            _statements,
+            digest=digest if isinstance(digest, str) else None,
         ),
         functions=tuple(
             [

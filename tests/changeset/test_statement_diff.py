@@ -8,7 +8,9 @@ from hypothesis import strategies as st
 
 from archmetrics.changeset import statement_diff
 from archmetrics.changeset.statement_diff import Action, diff_statements, similarity
-from archmetrics.facts import Span, Statement
+from archmetrics.facts import Deferred, Span, Statement
+from archmetrics.sources import codec
+from tests.harness import facts_of
 
 
 def stmts(*items: tuple[str, str]) -> tuple[Statement, ...]:
@@ -147,3 +149,15 @@ def test_counts_balance_and_are_never_negative(
 def test_identical_sequences_count_zero(items: list[tuple[str, str]]) -> None:
     change = diff_statements(stmts(*items), stmts(*items))
     assert change.total == 0 and change.changes == ()
+
+
+def test_cached_files_that_changed_only_in_layout_are_not_decoded() -> None:
+    before = facts_of("def f(a):\n    return a+1\n", "python")
+    after = facts_of("# note\ndef f(a):\n\n    return a + 1  # same\n", "python")
+    changed = facts_of("def f(a):\n    return a + 2\n", "python")
+    pre, post, other = (codec.decode(codec.encode(f), "m.py") for f in (before, after, changed))
+    assert isinstance(pre.statements, Deferred) and isinstance(post.statements, Deferred)
+    change = statement_diff.diff_files(pre, post)
+    assert (change.added, change.removed, change.modified) == (0, 0, 0)
+    assert (pre.statements._items, post.statements._items) == (None, None)
+    assert statement_diff.diff_files(pre, other).modified == 1  # decoded when they differ
