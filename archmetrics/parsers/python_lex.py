@@ -48,8 +48,8 @@ class Tokens:
     ``text[i]``, ``starts[i]``/``ends[i]`` (first and last line) and ``offsets[i]`` (character
     offset of its first character in the piece) describe token ``i``; ``closing[i]`` is the
     index of the bracket that closes the opening bracket ``i``. A piece that is not a whole
-    file (an f-string's expression, read on its own) has ``base`` its offset in the file and
-    ``glued`` set: inside an f-string libcst sees one token, so some lines are taken as it does.
+    file (an f-string's replacement field, read on its own) has ``base``, its offset in the
+    file, and ``first_line``, the file's line it starts on.
     """
 
     __slots__ = (
@@ -58,7 +58,6 @@ class Tokens:
         "base",
         "closing",
         "ends",
-        "glued",
         "multiline",
         "offsets",
         "soft_keywords",
@@ -66,16 +65,15 @@ class Tokens:
         "text",
     )
 
-    def __init__(self, source: str, base: int = 0, first_line: int = 1, glued: bool = False):
+    def __init__(self, source: str, base: int = 0, first_line: int = 1):
         self.text: list[str] = []
         self.starts: list[int] = []
         self.ends: list[int] = []
         self.offsets: list[int] = []
         self.multiline: list[int] = []  # tokens that span lines (strings)
         self.closing: dict[int, int] = {}
-        self.soft_keywords: set[int] = set()  # "match"/"case"/"type" used as keywords
+        self.soft_keywords: set[int] = set()  # "match" and "case" where they are keywords
         self.base = base
-        self.glued = glued
         _read(self, source, first_line)
         self._at_start = dict(zip(self.offsets, count()))
         self._at_end = dict(zip(map(add, self.offsets, map(len, self.text)), count(1)))

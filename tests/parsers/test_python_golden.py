@@ -587,6 +587,14 @@ def test_a_call_in_parentheses_spans_them() -> None:
     assert site.span == Span(1, 3)
 
 
+def test_parentheses_after_a_soft_keyword_are_the_subjects_own() -> None:
+    source = "match (\n    f(x)\n):\n    case _:\n        match(y)\n"
+    assert [(c.callee, c.span) for c in py(source).call_sites] == [
+        ("f", Span(1, 3)),
+        ("match", Span(5, 5)),
+    ]
+
+
 def test_calls_and_decisions_inside_fstrings_have_their_own_lines() -> None:
     source = (
         'def f():\n    s = f"""{\n        a if b else c} {g(\n        1)}"""\n'
