@@ -1,8 +1,10 @@
-"""Python parser: source text in, :class:`FileFacts` out, via one libcst parse and one pass.
+"""Python parser: source text in, :class:`FileFacts` out.
 
-The rules (what is a logical line, what is a decision point) are in docs/metrics.md and in
-python_rules.py; the pass itself is python_walk.py. Bad input never raises: a file libcst
-cannot parse is reported with a warning naming the line, and nothing is guessed from it.
+Two readers apply the same rules (docs/metrics.md, "How a file is read"): the standard
+library's (``ast`` and the token stream, python_ast.py) reads every file the running
+interpreter parses; libcst's (python_walk.py) reads the rest, and is imported only then.
+Bad input never raises: a file neither can parse is reported with a warning naming the line,
+and nothing is guessed from it.
 """
 
 from __future__ import annotations
@@ -12,13 +14,13 @@ import re
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
-
-import libcst as cst
-from libcst import CSTNode
+from typing import TYPE_CHECKING
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import python_ast
-from archmetrics.parsers.python_walk import FactsWalker
+
+if TYPE_CHECKING:
+    import libcst as cst
 
 _ERROR_AT = re.compile(r"error at (\d+):(\d+)")
 _ERROR_PREFIX = re.compile(r"^(?:parser|tokenizer) error: (?:error at \d+:\d+: )?")
@@ -49,6 +51,10 @@ def _standard_tree(source: str) -> ast.Module | None:
 
 def parse_with_libcst(path: str, source: str) -> FileFacts:
     """Facts of one Python file through libcst (newlines already normalized)."""
+    import libcst as cst
+
+    from archmetrics.parsers.python_walk import FactsWalker
+
     try:
         with _unvalidated_nodes():
             module = cst.parse_module(source)
@@ -76,7 +82,7 @@ def parse_with_libcst(path: str, source: str) -> FileFacts:
     )
 
 
-def _no_validation(node: CSTNode) -> None:
+def _no_validation(node: cst.CSTNode) -> None:
     """Stands in for ``CSTNode.__post_init__`` while the parser builds a tree."""
 
 
@@ -88,6 +94,8 @@ def _unvalidated_nodes() -> Iterator[None]:
     method says. Skipping them takes a quarter off ``parse_module``, the dominant cost of
     measuring Python (docs/performance.md). The hook is put back when the parse ends, even
     on error, so nodes built anywhere else are still checked."""
+    from libcst import CSTNode
+
     original = CSTNode.__dict__.get("__post_init__")
     if original is None:  # a libcst without the hook: nothing to skip
         yield

@@ -181,7 +181,11 @@ class _Reader(ExpressionReader):
     def with_(self, node: ast.With | ast.AsyncWith, target: Frame | None) -> None:
         parts = [part for item in node.items for part in (item.context_expr, item.optional_vars)]
         last = max(self.end(part) for part in parts if part is not None)
-        self.header("with", self.first(node), last, None)
+        first, text = self.first(node), self.tokens.text
+        opening = first + 1 if text[first] == "with" else first + 2  # after "async with"
+        if text[opening] == "(" and self.tokens.closing.get(opening) == self.colon(last) - 1:
+            self.tokens.statement_parens.add(opening)  # `with (a, b):`: the statement's own
+        self.header("with", first, last, None)
         self.expressions(parts, target)  # type: ignore[arg-type]
         self.body(node.body, target, docstrings=False)
 

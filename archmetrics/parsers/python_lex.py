@@ -62,6 +62,7 @@ class Tokens:
         "offsets",
         "soft_keywords",
         "starts",
+        "statement_parens",
         "text",
     )
 
@@ -73,6 +74,7 @@ class Tokens:
         self.multiline: list[int] = []  # tokens that span lines (strings)
         self.closing: dict[int, int] = {}
         self.soft_keywords: set[int] = set()  # "match" and "case" where they are keywords
+        self.statement_parens: set[int] = set()  # "(" of a statement: `with (a, b):`
         self.base = base
         _read(self, source, first_line)
         self._at_start = dict(zip(self.offsets, count()))
@@ -124,6 +126,7 @@ class Tokens:
             and end < len(text)
             and text[first - 1] == "("
             and closing.get(first - 1) == end
+            and first - 1 not in self.statement_parens
             and not self.opens_call(first - 1)
         ):
             first -= 1

@@ -587,6 +587,18 @@ def test_a_call_in_parentheses_spans_them() -> None:
     assert site.span == Span(1, 3)
 
 
+@pytest.mark.parametrize(
+    ("source", "line"),
+    [
+        ("    with (\n        a if b else c\n    ):\n        pass\n", 3),  # the statement's
+        ("    with (\n        a if b else c\n    ) as d:\n        pass\n", 2),  # the item's
+    ],
+)
+def test_parentheses_of_a_with_statement_are_its_own(source: str, line: int) -> None:
+    (function,) = py("def f():\n" + source).functions
+    assert [(d.kind, d.line) for d in function.decisions] == [("ifexp", line)]
+
+
 def test_parentheses_after_a_soft_keyword_are_the_subjects_own() -> None:
     source = "match (\n    f(x)\n):\n    case _:\n        match(y)\n"
     assert [(c.callee, c.span) for c in py(source).call_sites] == [
