@@ -35,8 +35,6 @@ from archmetrics.parsers.python_ast_rules import (
 )
 from archmetrics.parsers.python_lex import Unreadable
 
-_DEPTH = {"(": 1, "[": 1, "{": 1, ")": -1, "]": -1, "}": -1}
-
 
 def read(path: str, source: str, tree: ast.Module) -> FileFacts:
     """Facts of one Python file that ``ast`` parsed (``generated`` is left to the registry).
@@ -79,14 +77,6 @@ class _Reader(ExpressionReader):
         self.classes: list[Class | None] = []
         self.dependencies: list[Dependency] = []
         self.docstrings: list[tuple[int, int]] = []  # token ranges
-
-    def colon(self, index: int) -> int:
-        """The ``:`` that ends a compound statement's header, from token ``index`` on."""
-        text, depth = self.tokens.text, 0
-        while text[index] != ":" or depth > 0:
-            depth += _DEPTH.get(text[index], 0)
-            index += 1
-        return index
 
     def statement_start(self, node: ast.stmt) -> int:
         """A statement's first token: the ``@`` of its first decorator, if it has one."""
@@ -149,7 +139,7 @@ class _Reader(ExpressionReader):
     def header(self, kind: str, first: int, after: int, target: Frame | None) -> None:
         """A compound header from token ``first`` to the ``:`` found from ``after`` on,
         with its decision point (``target`` None: it has none)."""
-        self.add_statement(kind, first, self.colon(after) + 1)
+        self.add_statement(kind, first, self.tokens.colon(after) + 1)
         self.decide(target, kind, first)
 
     def else_(self, orelse: list[ast.stmt], target: Frame | None, kind: str | None) -> None:
@@ -183,7 +173,7 @@ class _Reader(ExpressionReader):
         last = max(self.end(part) for part in parts if part is not None)
         first, text = self.first(node), self.tokens.text
         opening = first + 1 if text[first] == "with" else first + 2  # after "async with"
-        if text[opening] == "(" and self.tokens.closing.get(opening) == self.colon(last) - 1:
+        if text[opening] == "(" and self.tokens.closing.get(opening) == self.tokens.colon(last) - 1:
             self.tokens.statement_parens.add(opening)  # `with (a, b):`: the statement's own
         self.header("with", first, last, None)
         self.expressions(parts, target)  # type: ignore[arg-type]
@@ -230,7 +220,7 @@ class _Reader(ExpressionReader):
         returns = getattr(node, "returns", None)
         after = self.end(returns) if returns is not None else syntax
         kind = "def" if is_def else "class"
-        self.add_statement(kind, self.statement_start(node), self.colon(after) + 1)
+        self.add_statement(kind, self.statement_start(node), self.tokens.colon(after) + 1)
         header = [*node.decorator_list, *getattr(node, "type_params", ())]
         if is_def:
             header += [node.args, returns]  # type: ignore[union-attr]

@@ -100,6 +100,16 @@ class Tokens:
             index -= 1
         return index
 
+    def colon(self, index: int) -> int:
+        """The ``:`` that ends a compound statement's header, from token ``index`` on (one
+        inside brackets, of a slice or a lambda, is not it)."""
+        text, depth = self.text, 0
+        while text[index] != ":" or depth > 0:
+            token = text[index]
+            depth += 1 if token in _OPENERS else -1 if token in _CLOSERS else 0
+            index += 1
+        return index
+
     def joined(self, first: int, end: int) -> str:
         """Normalized text of tokens ``first:end``: joined by single spaces."""
         return " ".join(self.text[first:end])
@@ -164,6 +174,19 @@ def _read(tokens: Tokens, source: str, first_line: int) -> None:
     """Fill ``tokens`` from ``source`` (lines numbered from ``first_line``)."""
     if not (_ONE_REGEX and _scan(tokens, source, first_line)):
         _read_tokenize(tokens, source, first_line)
+    _finish(tokens)
+
+
+def _finish(tokens: Tokens) -> None:
+    """What follows from the tokens read: which span lines, which bracket closes which."""
+    text = tokens.text
+    tokens.multiline = list(compress(count(), map(ne, tokens.starts, tokens.ends)))
+    opened: list[int] = []
+    for index in compress(count(), map(_BRACKETS.__contains__, text)):
+        if text[index] in _OPENERS:
+            opened.append(index)
+        elif opened:
+            tokens.closing[opened.pop()] = index
 
 
 def _scan(tokens: Tokens, source: str, first_line: int) -> bool:
@@ -178,17 +201,10 @@ def _scan(tokens: Tokens, source: str, first_line: int) -> bool:
     if (lengths[-1] if lengths else 0) + trailing != len(source):
         return False  # a character no pattern matched was skipped
     lines = list(accumulate(map(str.count, flat, repeat("\n")), initial=first_line))
-    tokens.text = text = flat[1::2]
+    tokens.text = flat[1::2]
     tokens.offsets = lengths[0::2]
-    tokens.starts = starts = lines[1::2]
-    tokens.ends = ends = lines[2::2]
-    tokens.multiline = list(compress(count(), map(ne, starts, ends)))
-    opened: list[int] = []
-    for index in compress(count(), map(_BRACKETS.__contains__, text)):
-        if text[index] in _OPENERS:
-            opened.append(index)
-        elif opened:
-            tokens.closing[opened.pop()] = index
+    tokens.starts = lines[1::2]
+    tokens.ends = lines[2::2]
     return True
 
 
@@ -198,8 +214,7 @@ def _read_tokenize(tokens: Tokens, source: str, first_line: int) -> None:
     for line in source.split("\n"):
         line_offsets.append(line_offsets[-1] + len(line) + 1)
     shift = first_line - 1
-    text, offsets = tokens.text, tokens.offsets
-    opened: list[int] = []
+    offsets = tokens.offsets
     glue_depth = 0
     glue_from = (0, 0)
     try:
@@ -226,17 +241,11 @@ def _read_tokenize(tokens: Tokens, source: str, first_line: int) -> None:
                 raise Unreadable(f"unexpected token {value!r} at line {start[0] + shift}")
             _add(tokens, value, start[0] + shift, end[0] + shift)
             offsets.append(line_offsets[start[0] - 1] + start[1])
-            if value in _OPENERS:
-                opened.append(len(text) - 1)
-            elif value in _CLOSERS and opened:
-                tokens.closing[opened.pop()] = len(text) - 1
     except (tokenize.TokenError, SyntaxError) as error:
         raise Unreadable(str(error)) from error
 
 
 def _add(tokens: Tokens, value: str, start: int, end: int) -> None:
-    if start != end:
-        tokens.multiline.append(len(tokens.text))
     tokens.text.append(value)
     tokens.starts.append(start)
     tokens.ends.append(end)

@@ -70,6 +70,8 @@ def test_the_one_regex_lexer_finds_the_tokens_tokenize_finds() -> None:
         except python_lex.Unreadable:
             continue  # not Python tokenize reads; nor does the regex, below
         assert python_lex._scan(regex, source, 1), path
+        python_lex._finish(regex)
+        python_lex._finish(standard)
         for name in ("text", "starts", "ends", "offsets", "multiline", "closing"):
             assert getattr(regex, name) == getattr(standard, name), (path, name)
 
