@@ -8,13 +8,14 @@ comments and blank lines: the statement texts must not notice.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from radon.complexity import cc_visit
 
-from archmetrics.facts import FileFacts
+from archmetrics.facts import FileFacts, Span
 from archmetrics.parsers import LanguageTable, parse_source, python, python_ast
 from archmetrics.parsers.python import parse
 
@@ -216,8 +217,26 @@ def test_python_like_fragments_never_raise(text: str) -> None:
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(PYTHONISH)
 def test_both_readers_agree_on_python_like_fragments(text: str) -> None:
+    # libcst drops a line holding only a `\` before a statement, and the lines after it
+    # with it (docs/metrics.md, "How a file is read"): left to the golden case below
+    assume(not _DROPPED_BY_LIBCST.search(text.replace("\r", "\n")))
     through_ast, through_libcst = both_readers("frag.py", text)
     assert through_ast == through_libcst
+
+
+_DROPPED_BY_LIBCST = re.compile(r"(?m)^[ \t\f]*\\\n")
+
+
+def test_a_line_holding_only_a_continuation_counts_for_the_lines_after_it() -> None:
+    source = "x = 1\n\\\ny = 2\n"
+    tree = python._standard_tree(source)
+    assert tree is not None
+    through_ast = python_ast.read("c.py", source, tree)
+    assert [s.span for s in through_ast.statements] == [Span(1, 1), Span(3, 3)]
+    assert [s.span for s in python.parse_with_libcst("c.py", source).statements] == [
+        Span(1, 1),
+        Span(2, 2),  # libcst's round trip loses the continuation line (libcst 1.x)
+    ]
 
 
 @settings(max_examples=200, deadline=None)
