@@ -21,6 +21,7 @@ from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
 from archmetrics.parsers import UnknownLanguage
 from archmetrics.sources import SourceError
+from archmetrics.sources.cache import CacheError
 from archmetrics.sources.codec import CodecError
 from archmetrics.study.manifest import ManifestError
 
@@ -44,6 +45,7 @@ CANNOT_MEASURE = (
     RulePackError,
     SeriesError,
     ManifestError,
+    CacheError,
 )
 
 

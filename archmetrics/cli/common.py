@@ -13,8 +13,7 @@ from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.config import Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
-from archmetrics.sources.cache import FactsCache
-from archmetrics.sources.cache import default_path as cache_default_path
+from archmetrics.sources.cache import FactsCache, choose_path
 
 EXIT_OK, EXIT_GATE, EXIT_USAGE = 0, 1, 2
 
@@ -95,17 +94,27 @@ def emit(text: str, output: Path | None) -> None:
         raise UsageError(f"{output}: cannot write: {error.strerror}") from error
 
 
+def cache_location(args: argparse.Namespace, settings: Settings) -> Path:
+    """The cache file: the flag, the environment, the configuration (confined), the default."""
+    return choose_path(getattr(args, "cache_path", None), settings.cache_path, settings.source)
+
+
 @contextmanager
 def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsCache | None]:
-    """The cache the flags and settings ask for (none with --no-cache or cache = false)."""
+    """The cache the flags and settings ask for (none with --no-cache or cache = false).
+    Problems it recovered from are printed as it opens and, if more came up, as it closes."""
     if getattr(args, "no_cache", False) or not settings.cache:
         yield None
         return
-    path = args.cache_path or (Path(settings.cache_path) if settings.cache_path else None)
-    with FactsCache(path or cache_default_path()) as cache:
+    with FactsCache(cache_location(args, settings)) as cache:
         for notice in cache.notices:
             print(f"archmetrics: warning: {notice}", file=sys.stderr)
-        yield cache
+        shown = len(cache.notices)
+        try:
+            yield cache
+        finally:
+            for notice in cache.notices[shown:]:
+                print(f"archmetrics: warning: {notice}", file=sys.stderr)
 
 
 def gate_status(failures: Sequence[GateFailure]) -> int:

@@ -8,8 +8,10 @@ of Python (whose ``ast`` reads Python files), of libcst or of tree-sitter wrote.
 are applied to facts after the cache (coupling reads call sites, which do not depend on
 rules), so they need no part in the key.
 
-A corrupt file, or one that is not ours, is moved aside with a warning and a new cache is
-built; a bad entry is dropped and parsed again. The cache is never trusted blindly.
+The file itself is handled by :mod:`archmetrics.sources.cache_file`: a path that is not an
+archmetrics cache is refused and left alone; our own cache, when damaged (at open or when a
+page turns out bad mid-run), is moved aside with a notice and rebuilt; a bad entry is dropped
+and parsed again. The cache is never trusted blindly, and never writes where it should not.
 """
 
 from __future__ import annotations
@@ -18,22 +20,39 @@ import hashlib
 import os
 import sqlite3
 import sys
-import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cache
 from importlib import metadata
 from pathlib import Path
+from typing import TypeVar
 
 import archmetrics
 from archmetrics.facts import FileFacts
 from archmetrics.sources import codec
+from archmetrics.sources.cache_file import (
+    CacheError,
+    choose_path,
+    configured_path,
+    default_path,
+    is_damage,
+    open_database,
+    rebuild,
+)
 
-APPLICATION = "archmetrics-facts"
-SCHEMA = "1"
+__all__ = [
+    "CacheError",
+    "FactsCache",
+    "choose_path",
+    "configured_path",
+    "default_path",
+    "parser_fingerprint",
+]
+
 DECODED_LIMIT = 50_000  # decoded facts kept in memory per run, at most
 
 
+_T = TypeVar("_T")
 _PARSING_LIBRARIES = ("libcst", "tree-sitter", "tree-sitter-c", "tree-sitter-cpp")
 
 
@@ -56,14 +75,6 @@ def parser_fingerprint() -> str:
     return digest.hexdigest()[:16]
 
 
-def default_path() -> Path:
-    """``$ARCHMETRICS_CACHE`` if set, else facts.sqlite3 in the user's cache directory."""
-    from platformdirs import user_cache_dir
-
-    override = os.environ.get("ARCHMETRICS_CACHE")
-    return Path(override) if override else Path(user_cache_dir("archmetrics")) / "facts.sqlite3"
-
-
 @dataclass(frozen=True, slots=True)
 class CacheInfo:
     path: str
@@ -77,7 +88,7 @@ class FactsCache:
     """A SQLite store of facts. Use as a context manager; writes are committed on close."""
 
     def __init__(self, path: Path):
-        self.path = path
+        self.path = Path(os.path.realpath(path.expanduser()))
         self.fingerprint = parser_fingerprint()
         self.hits = 0
         self.misses = 0
@@ -87,67 +98,42 @@ class FactsCache:
         # warm path's main cost. Frozen facts are safe to share (and sharing them halves a
         # diff's memory); bounded so a long series of revisions does not hold every version.
         self._decoded: dict[tuple[str, str], FileFacts] = {}
-        self._db = self._open()
+        self._db = open_database(self.path, self.notices)
 
-    def _open(self) -> sqlite3.Connection:
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+    def _run(self, query: Callable[[sqlite3.Connection], _T]) -> _T:
+        """``query`` on the database; if SQLite finds the file damaged (a bad page deep in
+        it shows only when read), the file is moved aside, a new cache started and the query
+        run once more on it."""
         try:
-            db = sqlite3.connect(self.path, timeout=30)
-            self._check(db)
-            return db
+            return query(self._db)
         except sqlite3.DatabaseError as error:
-            return self._rebuild(f"unreadable ({error})")
-        except _Foreign as error:
-            return self._rebuild(str(error))
-
-    def _check(self, db: sqlite3.Connection) -> None:
-        tables = {row[0] for row in db.execute("select name from sqlite_master where type='table'")}
-        if not tables:
-            db.executescript(
-                "create table meta(key text primary key, value text);"
-                "create table facts(blob text, language text, parser text, data blob,"
-                " primary key(blob, language, parser));"
-            )
-            db.executemany(
-                "insert into meta values (?, ?)", [("application", APPLICATION), ("schema", SCHEMA)]
-            )
-            db.commit()
-            return
-        meta = (
-            dict(db.execute("select key, value from meta").fetchall()) if "meta" in tables else {}
-        )
-        if meta.get("application") != APPLICATION or meta.get("schema") != SCHEMA:
-            db.close()
-            raise _Foreign("not an archmetrics facts cache (or an older layout)")
-
-    def _rebuild(self, why: str) -> sqlite3.Connection:
-        aside = self.path.with_name(f"{self.path.name}.bad-{int(time.time())}")
-        self.notices.append(
-            f"facts cache {self.path} is {why}; moved it to {aside.name} and started a new one"
-        )
-        self.path.replace(aside)
-        db = sqlite3.connect(self.path, timeout=30)
-        self._check(db)
-        return db
+            if not is_damage(error):
+                raise CacheError(f"facts cache {self.path}: {error}") from error
+            self._db.close()
+            self._db = rebuild(self.path, f"damaged ({error})", self.notices)
+            return query(self._db)
 
     def get(self, blob: str, language: str, path: str) -> FileFacts | None:
         known = self._decoded.get((blob, language))
         if known is not None and known.path == path:
             self.hits += 1
             return known
-        row = self._db.execute(
-            "select data from facts where blob=? and language=? and parser=?",
-            (blob, language, self.fingerprint),
-        ).fetchone()
+        key = (blob, language, self.fingerprint)
+        row = self._run(
+            lambda db: db.execute(
+                "select data from facts where blob=? and language=? and parser=?", key
+            ).fetchone()
+        )
         if row is None:
             self.misses += 1
             return None
         try:
             facts = codec.decode(row[0], path)
         except codec.CodecError:
-            self._db.execute(
-                "delete from facts where blob=? and language=? and parser=?",
-                (blob, language, self.fingerprint),
+            self._run(
+                lambda db: db.execute(
+                    "delete from facts where blob=? and language=? and parser=?", key
+                )
             )
             self.misses += 1
             return None
@@ -169,33 +155,35 @@ class FactsCache:
         """Store (blob, language, ``codec.encode(facts)``) rows already encoded elsewhere
         (the parser processes encode what they send back, so nothing is encoded twice)."""
         rows = [(blob, language, self.fingerprint, data) for blob, language, data in items]
-        self._db.executemany("insert or replace into facts values (?, ?, ?, ?)", rows)
+        self._run(
+            lambda db: db.executemany("insert or replace into facts values (?, ?, ?, ?)", rows)
+        )
 
     def info(self) -> CacheInfo:
-        total = self._db.execute("select count(*) from facts").fetchone()[0]
-        current = self._db.execute(
-            "select count(*) from facts where parser=?", (self.fingerprint,)
-        ).fetchone()[0]
+        total, current = self._run(
+            lambda db: db.execute(
+                "select count(*), count(case when parser=? then 1 end) from facts",
+                (self.fingerprint,),
+            ).fetchone()
+        )
         size = self.path.stat().st_size if self.path.exists() else 0
         return CacheInfo(str(self.path), total, size, self.fingerprint, current)
 
     def clear(self) -> int:
         self._decoded.clear()
-        removed: int = self._db.execute("delete from facts").rowcount
-        self._db.commit()
-        self._db.execute("vacuum")
+        removed: int = self._run(lambda db: db.execute("delete from facts").rowcount)
+        self._run(lambda db: db.commit())
+        self._run(lambda db: db.execute("vacuum"))
         return removed
 
     def close(self) -> None:
-        self._db.commit()
-        self._db.close()
+        try:
+            self._run(lambda db: db.commit())
+        finally:
+            self._db.close()
 
     def __enter__(self) -> FactsCache:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-class _Foreign(Exception):
-    pass

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+import time
 import zlib
 from pathlib import Path
 from typing import Any
@@ -26,8 +27,8 @@ from archmetrics.facts import (
     Statement,
 )
 from archmetrics.sources import cache as cache_module
-from archmetrics.sources import codec
-from archmetrics.sources.cache import FactsCache
+from archmetrics.sources import cache_file, codec
+from archmetrics.sources.cache import CacheError, FactsCache
 from tests.harness import facts_of
 
 SAMPLE = FileFacts(
@@ -170,9 +171,96 @@ def test_cache_hits_by_blob_and_survives_reopen(tmp_path: Path) -> None:
         assert cache.get("abc", "python", "a/b.py") is None
 
 
-def test_corrupt_cache_is_moved_aside_and_rebuilt(tmp_path: Path) -> None:
+def _tree(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` and its bytes: to show nothing was touched."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.parametrize(
+    "content",
+    [
+        b"this is not a database" * 100,
+        b"",
+        b"print('hello')\n",
+        b"SQLite format 3\x00" + b"\0" * 84,
+    ],
+    ids=["text", "empty", "source", "bare-header"],
+)
+def test_a_file_that_is_not_a_cache_is_refused_and_left_alone(
+    tmp_path: Path, content: bytes
+) -> None:
     path = tmp_path / "cache.sqlite3"
-    path.write_bytes(b"this is not a database" * 100)
+    path.write_bytes(content)
+    with pytest.raises(CacheError, match="not an archmetrics facts cache"):
+        FactsCache(path)
+    assert _tree(tmp_path) == {"cache.sqlite3": content}
+
+
+def test_a_foreign_database_is_refused_and_left_alone(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    db = sqlite3.connect(path)
+    db.execute("create table facts(blob, language, parser, data)")
+    db.commit()
+    db.close()
+    before = _tree(tmp_path)
+    with pytest.raises(CacheError, match="not an archmetrics facts cache"):
+        FactsCache(path)
+    assert _tree(tmp_path) == before
+
+
+def test_a_directory_is_refused_and_left_alone(tmp_path: Path) -> None:
+    git = tmp_path / ".git"
+    (git / "objects").mkdir(parents=True)
+    (git / "HEAD").write_text("ref: refs/heads/main\n")
+    before = _tree(tmp_path)
+    with pytest.raises(CacheError, match="not a regular file"):
+        FactsCache(git)
+    assert _tree(tmp_path) == before
+
+
+def test_a_new_cache_carries_the_application_id(tmp_path: Path) -> None:
+    path = tmp_path / "deep" / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        assert cache.notices == []
+    header = path.read_bytes()[:100]
+    assert int.from_bytes(header[68:72], "big") == cache_file.APPLICATION_ID
+    assert sorted(p.name for p in path.parent.iterdir()) == ["cache.sqlite3"]
+
+
+def test_a_cache_written_before_the_application_id_is_still_ours(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+    db = sqlite3.connect(path)
+    db.execute("pragma application_id = 0")
+    db.commit()
+    db.close()
+    with FactsCache(path) as cache:
+        assert cache.notices == []
+        assert cache.get("abc", "python", "a/b.py") is not None
+
+
+def _damage(path: Path, table_change: str) -> None:
+    db = sqlite3.connect(path)
+    db.executescript(table_change)
+    db.commit()
+    db.close()
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        "drop table facts",
+        "drop table facts; create table facts(x, y)",
+        "update meta set value = '0' where key = 'schema'",
+    ],
+    ids=["facts-missing", "facts-wrong", "older-layout"],
+)
+def test_our_cache_with_bad_tables_is_moved_aside_and_rebuilt(tmp_path: Path, change: str) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+    _damage(path, change)
     with FactsCache(path) as cache:
         assert cache.notices and "moved it to" in cache.notices[0]
         cache.put_many([("abc", SAMPLE)])
@@ -180,16 +268,56 @@ def test_corrupt_cache_is_moved_aside_and_rebuilt(tmp_path: Path) -> None:
     assert len(list(tmp_path.glob("cache.sqlite3.bad-*"))) == 1
 
 
-def test_foreign_database_is_not_trusted_nor_destroyed(tmp_path: Path) -> None:
+def test_a_damaged_page_found_mid_run_rebuilds_the_cache(tmp_path: Path) -> None:
     path = tmp_path / "cache.sqlite3"
-    db = sqlite3.connect(path)
-    db.execute("create table facts(blob, language, parser, data)")
-    db.commit()
-    db.close()
+    blobs = [f"{n:040x}" for n in range(400)]
     with FactsCache(path) as cache:
-        assert "not an archmetrics facts cache" in cache.notices[0]
+        cache.put_many([(blob, SAMPLE) for blob in blobs])
+    data = bytearray(path.read_bytes())
+    data[-4096:] = b"\xff" * 4096  # the last page: the header and the first pages stay good
+    path.write_bytes(bytes(data))
+    with FactsCache(path) as cache:
+        assert cache.notices == []  # found only when the page is read
+        found = [cache.get(blob, "python", "a/b.py") for blob in blobs]
+        assert any("damaged" in notice for notice in cache.notices)
+        assert found.count(None) >= 1
+        cache.put_many([("abc", SAMPLE)])
+        assert cache.get("abc", "python", "a/b.py") is not None
     [aside] = tmp_path.glob("cache.sqlite3.bad-*")
-    assert sqlite3.connect(aside).execute("select count(*) from facts").fetchone() == (0,)
+    assert aside.read_bytes() == bytes(data)
+
+
+def test_moving_aside_never_overwrites_a_file(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path):
+        pass
+    _damage(path, "drop table facts")
+    for stamp in range(-2, 3):  # whatever second it is, the plain name is taken
+        path.with_name(f"cache.sqlite3.bad-{int(time.time()) + stamp}").write_text("keep me")
+    with FactsCache(path) as cache:
+        assert "moved it to" in cache.notices[0]
+    kept = [p for p in tmp_path.glob("cache.sqlite3.bad-*") if p.read_bytes() == b"keep me"]
+    assert len(kept) == 5
+
+
+def test_a_configured_path_stays_inside_the_cache_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "home-cache"))
+    root = cache_file.cache_directory()
+    assert cache_module.configured_path("mine.sqlite3", "pyproject.toml") == root / "mine.sqlite3"
+    inside = str(root / "x" / "y.sqlite3")
+    assert cache_module.configured_path(inside, "pyproject.toml") == Path(inside)
+    monkeypatch.setenv("HOME", str(root))
+    assert cache_module.configured_path("~/z.db", "p") == root / "z.db"
+    assert cache_module.configured_path(".git", "p") == root / ".git"  # a name, not the repo's
+    for text in ("/", "/dev/null", "../x.sqlite3", "~", str(tmp_path / "a.db"), "."):
+        with pytest.raises(CacheError, match="outside archmetrics's cache directory"):
+            cache_module.configured_path(text, "pyproject.toml")
+    root.mkdir(parents=True)
+    (root / "link").symlink_to(tmp_path)
+    with pytest.raises(CacheError, match="outside"):
+        cache_module.configured_path("link/cache.sqlite3", "pyproject.toml")
 
 
 def test_bad_entry_is_dropped_and_reparsed(tmp_path: Path) -> None:
