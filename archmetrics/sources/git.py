@@ -2,7 +2,12 @@
 
 Blobs are read through GitPython's object database, which keeps one long-lived
 ``git cat-file --batch`` process per repository instead of one subprocess per file.
-Nothing here writes to the repository.
+
+Nothing here writes to the repository, and nothing here reaches the network: every git
+command runs with :data:`READ_ONLY`, so git neither refreshes the index's stat cache (which
+rewrites ``.git/index`` and takes ``index.lock``) nor fetches objects a partial clone left
+out. A revision or object that is not in the clone is a one-line :class:`SourceError`
+saying so and how to fetch it (docs/security.md).
 """
 
 from __future__ import annotations
@@ -10,7 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import git
-from git.exc import BadName, GitCommandError, InvalidGitRepositoryError, NoSuchPathError
+from git.exc import GitCommandError, GitError, InvalidGitRepositoryError, NoSuchPathError
 
 from archmetrics.sources.snapshot import (
     EMPTY,
@@ -23,22 +28,41 @@ from archmetrics.sources.snapshot import (
 
 EMPTY_TREE = "4b825dc642cb6eb9a060e54bf8d69288fbee4904"
 
+READ_ONLY = {
+    "GIT_OPTIONAL_LOCKS": "0",  # no index refresh, no index.lock
+    "GIT_NO_LAZY_FETCH": "1",  # a partial clone's missing objects are not fetched (git 2.44+)
+    "GIT_ALLOW_PROTOCOL": "",  # ... nor by older git: no transport is allowed at all
+    "GIT_TERMINAL_PROMPT": "0",  # never wait for a password
+}
+"""The environment of every git command archmetrics runs."""
+
 
 def is_repository(path: Path) -> bool:
     try:
         git.Repo(path, search_parent_directories=True)
     except (InvalidGitRepositoryError, NoSuchPathError):
         return False
+    except OSError as error:  # a symbolic-link loop, a folder we may not read
+        raise SourceError(f"{path}: cannot read: {error.strerror or error}") from error
     return True
 
 
 def open_repository(path: Path) -> git.Repo:
+    """The repository holding ``path``, its git commands set to :data:`READ_ONLY`."""
     try:
-        return git.Repo(path, search_parent_directories=True)
+        repo = git.Repo(path, search_parent_directories=True)
     except NoSuchPathError as error:
         raise SourceError(f"{path}: no such directory") from error
     except InvalidGitRepositoryError as error:
         raise SourceError(f"{path}: not inside a git repository") from error
+    except OSError as error:
+        raise SourceError(f"{path}: cannot read: {error.strerror or error}") from error
+    repo.git.update_environment(**READ_ONLY)
+    try:  # git's own checks (ownership, a broken .git) fail here, not halfway through
+        repo.git.execute(["git", "rev-parse", "--git-dir"])
+    except GitCommandError as error:
+        raise explain(repo, error, str(path)) from error
+    return repo
 
 
 def toplevel(repo: git.Repo) -> Path:
@@ -47,18 +71,57 @@ def toplevel(repo: git.Repo) -> Path:
     return Path(repo.working_tree_dir)
 
 
+def explain(repo: git.Repo, error: GitCommandError, doing: str) -> SourceError:
+    """A one-line error for a git command that failed, saying why where git says it."""
+    stderr = str(error.stderr or "")
+    if "dubious ownership" in stderr:
+        where = repo.working_tree_dir or repo.git_dir
+        return SourceError(
+            f"{where}: git refuses to read a repository owned by another user; if you trust "
+            f"it: git config --global --add safe.directory {where}"
+        )
+    if "promisor remote" in stderr or "lazy fetching disabled" in stderr:
+        return SourceError(
+            f"{doing}: the object is not in this partial clone and archmetrics does not fetch; "
+            "fetch it first (e.g. git fetch --refetch, or clone without --filter)"
+        )
+    if _is_shallow(repo):
+        return SourceError(
+            f"{doing}: not in this shallow clone; fetch the history first "
+            "(git fetch --unshallow, or fetch-depth: 0 in CI)"
+        )
+    last = stderr.strip().splitlines()[-1] if stderr.strip() else f"exit {error.status}"
+    return SourceError(f"{doing}: git failed: {last.removeprefix('stderr: ').strip()}")
+
+
+def _is_shallow(repo: git.Repo) -> bool:
+    return (Path(repo.git_dir) / "shallow").is_file()
+
+
 def resolve(repo: git.Repo, rev: str) -> str:
-    """The commit id ``rev`` names; SourceError with a one-line message when it names none."""
+    """The commit id ``rev`` names, in any syntax git accepts (``@{-1}``, ``v1^{commit}``,
+    ``HEAD@{yesterday}``); SourceError with a one-line message when it names none."""
     try:
-        return str(repo.commit(rev).hexsha)
-    except (BadName, ValueError, GitCommandError) as error:
+        out: str = repo.git.execute(
+            ["git", "rev-parse", "--verify", "--quiet", "--end-of-options", f"{rev}^{{commit}}"]
+        )
+    except GitCommandError as error:
+        if _is_shallow(repo):
+            raise SourceError(
+                f"unknown revision {rev!r} in this shallow clone: if it is older than the "
+                "clone's depth, fetch the history first (git fetch --unshallow, or "
+                "fetch-depth: 0 in CI)"
+            ) from error
+        if error.stderr and "dubious ownership" in str(error.stderr):
+            raise explain(repo, error, f"revision {rev!r}") from error
         raise SourceError(f"unknown revision {rev!r}") from error
+    return out.strip()
 
 
 def has_commits(repo: git.Repo) -> bool:
     try:
-        repo.head.commit  # noqa: B018 -- raises when HEAD points at no commit yet
-    except ValueError:
+        repo.git.execute(["git", "rev-parse", "--verify", "--quiet", "HEAD^{commit}"])
+    except GitCommandError:
         return False
     return True
 
@@ -68,8 +131,18 @@ def effective_spec(repo: git.Repo, spec: str) -> str:
     return EMPTY if spec == "HEAD" and not has_commits(repo) else spec
 
 
+def _count(repo: git.Repo, commit: str) -> int:
+    try:
+        return int(repo.git.execute(["git", "rev-list", "--count", commit]))
+    except GitCommandError as error:
+        raise explain(repo, error, f"the history of {commit}") from error
+
+
 def _ls(repo: git.Repo, *args: str) -> list[str]:
-    out: str = repo.git.execute(["git", *args], strip_newline_in_stdout=False)
+    try:
+        out: str = repo.git.execute(["git", *args], strip_newline_in_stdout=False)
+    except GitCommandError as error:
+        raise explain(repo, error, f"git {args[0]}") from error
     return [entry for entry in out.split("\0") if entry]
 
 
@@ -80,8 +153,13 @@ class _BlobReader:
     def read(self, file: SourceFile) -> bytes:
         try:
             data: bytes = self.repo.odb.stream(bytes.fromhex(file.blob)).read()
-        except (ValueError, GitCommandError) as error:
-            raise SourceError(f"{file.path}: cannot read blob {file.blob}") from error
+        except GitCommandError as error:
+            raise explain(self.repo, error, f"{file.path} (blob {file.blob})") from error
+        except (ValueError, GitError) as error:
+            raise SourceError(
+                f"{file.path}: cannot read blob {file.blob}: it is not in this clone "
+                "(a partial clone? archmetrics does not fetch; fetch it first)"
+            ) from error
         return data
 
 
@@ -129,21 +207,31 @@ class WorktreeSnapshot(DirectorySnapshot):
 
 
 def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:
-    """Paths renamed between two snapshot specs, old -> new, as ``git diff -M`` finds them."""
-    args = ["diff", "-M", "--name-status", "-z", "--no-ext-diff", "--diff-filter=R"]
+    """Paths renamed between two snapshot specs, old -> new, as ``git diff -M`` finds them.
+
+    Asked of git's plumbing (``diff-tree``, ``diff-index``, ``diff-files``), which compares
+    without refreshing the index: porcelain ``git diff`` against the working tree rewrites
+    ``.git/index`` even with optional locks off."""
     base, head = effective_spec(repo, base), effective_spec(repo, head)
     if base == EMPTY or head == EMPTY:
         return {}
+    options = ["-M", "--name-status", "-z", "--diff-filter=R"]
     if head == WORKTREE and base == INDEX:
-        pass  # plain `git diff`: index -> working tree
+        args = ["diff-files", *options]
     elif head == WORKTREE:
-        args.append(resolve(repo, base))
+        args = ["diff-index", *options, resolve(repo, base)]
     elif head == INDEX:
-        args += ["--cached", resolve(repo, base) if base != INDEX else "HEAD"]
+        args = [
+            "diff-index",
+            "--cached",
+            *options,
+            resolve(repo, base) if base != INDEX else "HEAD",
+        ]
     elif base in (INDEX, WORKTREE):
-        args += ["-R", resolve(repo, head)] + (["--cached"] if base == INDEX else [])
+        cached = ["--cached"] if base == INDEX else []
+        args = ["diff-index", "-R", *cached, *options, resolve(repo, head)]
     else:
-        args += [resolve(repo, base), resolve(repo, head)]
+        args = ["diff-tree", "-r", *options, resolve(repo, base), resolve(repo, head)]
     fields = _ls(repo, *args)
     pairs: dict[str, str] = {}
     for i in range(0, len(fields) - 2, 3):
@@ -160,5 +248,5 @@ def tags_in_order(path: Path) -> tuple[str, ...]:
     names = [str(tag) for tag in repo.tags]
     if not names:
         raise SourceError(f"{path}: no tags to take stages from; give --revisions")
-    depth = {name: int(repo.git.rev_list("--count", f"{name}^{{commit}}")) for name in names}
+    depth = {name: _count(repo, resolve(repo, name)) for name in names}
     return tuple(sorted(names, key=lambda name: (depth[name], name)))
