@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from archmetrics.changeset.locations import BadPattern, compile_glob
+
 CONFIG_FILES = ("archmetrics.toml", "pyproject.toml")
 
 
@@ -36,6 +38,34 @@ class CouplingSettings:
 
 
 @dataclass(frozen=True, slots=True)
+class LimitSettings:
+    """What one file may cost (docs/security.md, "Bounded work per file"). A repository's
+    configuration may lower or raise them, up to :data:`LIMIT_CEILINGS`."""
+
+    file_seconds: float = 120.0  # wall-clock seconds to parse one file
+    worker_memory_mb: int = 4096  # MiB of address space a parser process may add
+
+
+LIMIT_CEILINGS = {"file-seconds": 3600.0, "worker-memory-mb": 65536}
+"""The most a configuration may allow: an untrusted repository can make its own run slow,
+never endless."""
+
+
+def _limits(table: Mapping[str, Any], where: str) -> LimitSettings:
+    _check_keys(table, set(LIMIT_CEILINGS), where)
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        here, ceiling = f"{where}.{key}", LIMIT_CEILINGS[key]
+        number_types = (int, float) if key == "file-seconds" else (int,)
+        if not isinstance(value, number_types) or isinstance(value, bool):
+            raise ConfigError(f"{here}: expected a number")
+        if not 0 < value <= ceiling:  # NaN fails this too
+            raise ConfigError(f"{here}: expected more than 0 and at most {ceiling:g}")
+        values[key.replace("-", "_")] = value
+    return LimitSettings(**values)
+
+
+@dataclass(frozen=True, slots=True)
 class Settings:
     """Everything configurable, with its defaults. ``source`` names the file it came from."""
 
@@ -49,6 +79,7 @@ class Settings:
     cache_path: str | None = None
     cache: bool = True
     jobs: int = 0  # 0: one worker per core
+    limits: LimitSettings = field(default_factory=LimitSettings)
 
 
 def _strings(value: Any, where: str) -> tuple[str, ...]:
@@ -75,10 +106,21 @@ def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None
             raise ConfigError(f"{where}: unknown key {key!r} (known: {', '.join(sorted(allowed))})")
 
 
+def _globs(value: Any, where: str) -> tuple[str, ...]:
+    """A list of path globs, each checked now, so a bad one is named with its file and key."""
+    globs = _strings(value, where)
+    for glob in globs:
+        try:
+            compile_glob(glob)
+        except BadPattern as error:
+            raise ConfigError(f"{where}: {error}") from None
+    return globs
+
+
 def _locations(table: Mapping[str, Any], where: str) -> LocationSettings:
     _check_keys(table, {"new", "framework", "base"}, where)
     return LocationSettings(
-        **{key: _strings(value, f"{where}.{key}") for key, value in table.items()}
+        **{key: _globs(value, f"{where}.{key}") for key, value in table.items()}
     )
 
 
@@ -112,6 +154,7 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
         "cache-path",
         "cache",
         "jobs",
+        "limits",
     }
     _check_keys(table, known, source)
     values: dict[str, Any] = {"source": source}
@@ -123,7 +166,9 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
                 if not isinstance(language, str):
                     raise ConfigError(f"{here}.{ending}: expected a language name")
             values["languages"] = tuple(sorted(langs.items()))
-        elif key in ("exclude", "gates"):
+        elif key == "exclude":
+            values[key] = _globs(value, here)
+        elif key == "gates":
             values[key] = _strings(value, here)
         elif key in ("include-generated", "cache"):
             values[key.replace("-", "_")] = _bool(value, here)
@@ -131,6 +176,8 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
             values["locations"] = _locations(_table(value, here), here)
         elif key == "coupling":
             values["coupling"] = _coupling(_table(value, here), here)
+        elif key == "limits":
+            values["limits"] = _limits(_table(value, here), here)
         elif key == "cache-path":
             if not isinstance(value, str):
                 raise ConfigError(f"{here}: expected a path")
@@ -140,21 +187,40 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
     return Settings(**values)
 
 
+MAX_CONFIG_BYTES = 1 << 20
+"""A configuration file larger than this (1 MiB) is refused rather than read."""
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    """The TOML document at ``path``; ConfigError for anything that is not one, however odd
+    (a huge file, nesting deep enough to exhaust the parser's recursion, a bad encoding)."""
+    try:
+        if path.stat().st_size > MAX_CONFIG_BYTES:
+            raise ConfigError(f"{path}: larger than {MAX_CONFIG_BYTES} bytes; not read")
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{path}: not valid TOML: {error}") from error
+    except RecursionError:
+        raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
+    except OSError as error:
+        raise ConfigError(f"{path}: cannot read: {error.strerror or error}") from error
+
+
 def load_settings(root: Path) -> Settings:
     """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``."""
     for name in CONFIG_FILES:
         path = root / name
         if not path.is_file():
             continue
-        try:
-            document = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-            raise ConfigError(f"{path}: not valid TOML: {error}") from error
+        document = _read_toml(path)
+        tool = document.get("tool", {})
+        if not isinstance(tool, dict):
+            raise ConfigError(f"{path}: tool: expected a table")
         if name == "pyproject.toml":
-            table = document.get("tool", {}).get("archmetrics")
+            table = tool.get("archmetrics")
             if table is None:
                 continue
         else:
-            table = document.get("tool", {}).get("archmetrics", document)
-        return parse_settings(_table(table, str(path)), str(path))
+            table = tool.get("archmetrics", document)
+        return parse_settings(_table(table, f"{path}: tool.archmetrics"), str(path))
     return Settings()

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from archmetrics.app.collect import parse_all, select
+from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import Progress
 from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
@@ -96,9 +96,8 @@ def _parse_side(
 ) -> tuple[FileFacts, ...]:
     overrides = request.settings.languages
     selected = select(snapshot, LanguageTable.default(dict(overrides)))
-    return parse_all(
-        snapshot, selected, overrides, request.jobs or request.settings.jobs, progress, cache
-    )
+    jobs, limits = request.jobs or request.settings.jobs, worker_limits(request.settings.limits)
+    return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
 
 
 def measure_change(

@@ -6,7 +6,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from archmetrics.app.collect import parse_all, select
+from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import measure
 from archmetrics.app.progress import Progress
 from archmetrics.complexity import file_metrics, totals
@@ -15,7 +15,8 @@ from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import ScanReport
 from archmetrics.sources import SourceError, open_snapshot
 from archmetrics.sources.cache import FactsCache
-from archmetrics.sources.snapshot import DirectorySnapshot, Snapshot
+from archmetrics.sources.paths import quote_path
+from archmetrics.sources.snapshot import DirectorySnapshot, Snapshot, resolve_path
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,7 +34,7 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
     """The root, the snapshot and the path prefixes (relative to root) to keep."""
     from archmetrics.sources import git
 
-    targets = [p.resolve() for p in request.paths] or [Path.cwd().resolve()]
+    targets = [resolve_path(p) for p in request.paths] or [Path.cwd().resolve()]
     for target in targets:
         if not target.exists() and request.rev is None:
             raise SourceError(f"{target}: no such file or directory")
@@ -55,7 +56,7 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
 
 def _relative(target: Path, root: Path) -> str:
     try:
-        return target.relative_to(root).as_posix() if target != root else ""
+        return quote_path(target.relative_to(root).as_posix()) if target != root else ""
     except ValueError as error:
         raise SourceError(f"{target}: not under {root}") from error
 
@@ -87,14 +88,15 @@ def run_scan(
     selected = select(snapshot, table, lambda path: _under(path, prefixes))
     if not selected and request.rev is None and prefixes and len(request.paths) == 1:
         # a folder git ignores (a virtualenv, a build tree) is read as the plain folder it is
-        folder = request.paths[0].resolve()
+        folder = resolve_path(request.paths[0])
         if folder.is_dir():
             root, snapshot, prefixes = folder, DirectorySnapshot(folder), ()
             selected = select(snapshot, table)
     if not selected:
         raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
     jobs = request.jobs or request.settings.jobs
-    facts = parse_all(snapshot, selected, overrides, jobs, progress, cache)
+    limits = worker_limits(request.settings.limits)
+    facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
     metrics = tuple(file_metrics(f) for f in facts)
     return ScanReport(
         root=str(root),

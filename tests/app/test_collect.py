@@ -6,7 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from archmetrics.app.collect import PARALLEL_THRESHOLD, parse_all, select
+from archmetrics.app.collect import parse_all, select
+from archmetrics.app.workers import FORK_BELOW as PARALLEL_THRESHOLD
 from archmetrics.cli import main
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources.cache import FactsCache

@@ -1,0 +1,205 @@
+"""Parser processes under hostile input: a file that crashes, hangs or eats memory costs that
+file, named with the reason, never the run; and no worker outlives archmetrics."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.gitrepo import GitRepo
+from tests.untrusted import run_cli
+
+PLUGIN = '''
+import ctypes, os, time
+
+from archmetrics.parsers import LanguageSpec
+from archmetrics.parsers.python import parse as parse_python
+
+
+def parse(path, source):
+    if "SEGFAULT" in source:
+        ctypes.string_at(0)
+    if "ABORT" in source:
+        os.abort()
+    if "SLEEP" in source:
+        time.sleep(600)
+    if "HOG" in source:
+        hog = [bytearray(1 << 20) for _ in range(1 << 16)]
+    if "RAISE" in source:
+        raise ZeroDivisionError("the plugin's own bug")
+    return parse_python(path, source)
+
+
+SPEC = LanguageSpec("unruly", parse)
+'''
+FINE = "def f{i}(a):\n    if a:\n        return {i}\n    return 0\n"
+
+
+@pytest.fixture
+def plugin(tmp_path: Path) -> dict[str, str]:
+    """A third-party language (as installed through the ``archmetrics.languages`` entry-point
+    group) whose parser crashes, hangs, hogs memory or raises on request."""
+    site = tmp_path / "site"
+    (site / "unruly-1.0.dist-info").mkdir(parents=True)
+    (site / "unruly_lang.py").write_text(PLUGIN)
+    (site / "unruly-1.0.dist-info" / "METADATA").write_text("Name: unruly\nVersion: 1.0\n")
+    (site / "unruly-1.0.dist-info" / "entry_points.txt").write_text(
+        "[archmetrics.languages]\nunruly = unruly_lang:SPEC\n"
+    )
+    path = os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])
+    return {"PYTHONPATH": path}
+
+
+def _repo(repo: GitRepo, bad: dict[str, str], fine: int, limits: str = "") -> None:
+    files = {f"ok{i}.py": FINE.format(i=i) for i in range(fine)}
+    files.update(bad)
+    config = '[tool.archmetrics]\nlanguages = { ".un" = "unruly" }\n' + limits
+    repo.commit("v1", files={**files, "pyproject.toml": config})
+
+
+def _measured(out: str) -> dict[str, dict[str, object]]:
+    return {f["path"]: f for f in json.loads(out)["files"]}
+
+
+@pytest.mark.parametrize("fine", [3, 60], ids=["forked", "fork-server"])
+@pytest.mark.parametrize(
+    ("trigger", "reason"),
+    [
+        ("SEGFAULT", "died (SIGSEGV)"),
+        ("ABORT", "died (SIGABRT)"),
+        ("RAISE", "ZeroDivisionError: the plugin's own bug"),
+    ],
+)
+def test_a_file_that_breaks_its_parser_costs_that_file(
+    repo: GitRepo, plugin: dict[str, str], trigger: str, reason: str, fine: int
+) -> None:
+    _repo(repo, {"bad.un": f"x = 1  # {trigger}\n", "good.un": FINE.format(i=99)}, fine)
+    run = run_cli(["scan", ".", "--format", "json", "--no-cache", "-j", "2"], repo.root, plugin)
+    assert run.code == 0, run.err
+    files = _measured(run.out)
+    assert len(files) == fine + 2
+    [warning] = files["bad.un"]["warnings"]  # type: ignore[misc]
+    assert reason in warning["message"] and warning["message"].startswith("not measured")
+    assert files["good.un"]["vg"] == 2
+    assert all(files[f"ok{i}.py"]["vg"] == 2 for i in range(fine))
+
+
+def test_a_file_over_the_time_limit_is_cut_off(repo: GitRepo, plugin: dict[str, str]) -> None:
+    limits = "[tool.archmetrics.limits]\nfile-seconds = 1\n"
+    _repo(repo, {"slow.un": "# SLEEP\n", "also.un": FINE.format(i=7)}, 3, limits)
+    started = time.monotonic()
+    run = run_cli(["scan", ".", "--format", "json", "--no-cache"], repo.root, plugin)
+    assert run.code == 0, run.err
+    assert time.monotonic() - started < 60  # not the plugin's 600 s
+    files = _measured(run.out)
+    [warning] = files["slow.un"]["warnings"]  # type: ignore[misc]
+    assert "took longer than 1 s" in warning["message"]
+    assert files["also.un"]["vg"] == 2
+
+
+def test_a_file_over_the_memory_limit_is_not_measured(
+    repo: GitRepo, plugin: dict[str, str]
+) -> None:
+    limits = "[tool.archmetrics.limits]\nworker-memory-mb = 256\n"
+    _repo(repo, {"hog.un": "# HOG\n", "also.un": FINE.format(i=7)}, 3, limits)
+    run = run_cli(["scan", ".", "--format", "json", "--no-cache"], repo.root, plugin)
+    assert run.code == 0, run.err
+    files = _measured(run.out)
+    [warning] = files["hog.un"]["warnings"]  # type: ignore[misc]
+    assert "needed more than 256 MiB" in warning["message"]
+    assert files["also.un"]["vg"] == 2
+
+
+def test_files_cut_off_by_a_limit_are_not_cached(
+    repo: GitRepo, plugin: dict[str, str], tmp_path: Path
+) -> None:
+    _repo(repo, {"bad.un": "# ABORT\n"}, 1)
+    cache = ["--cache-path", str(tmp_path / "c.sqlite3"), "--format", "json"]
+    for _ in range(2):
+        run = run_cli(["scan", ".", *cache], repo.root, plugin)
+        assert "died (SIGABRT)" in run.out
+
+
+@pytest.mark.parametrize(
+    ("limits", "problem"),
+    [
+        ("file-seconds = 0", "more than 0"),
+        ("file-seconds = 1e9", "at most 3600"),
+        ("file-seconds = nan", "more than 0"),
+        ("worker-memory-mb = 1.5", "expected a number"),
+        ("worker-memory-mb = true", "expected a number"),
+        ("pages = 3", "unknown key 'pages'"),
+    ],
+)
+def test_limits_a_repository_sets_are_checked(repo: GitRepo, limits: str, problem: str) -> None:
+    repo.commit("v1", files={"pyproject.toml": f"[tool.archmetrics.limits]\n{limits}\n"})
+    run = run_cli(["scan", "."], repo.root)
+    assert run.code == 2
+    assert problem in run.one_line_error()
+
+
+def _descendants(pid: int) -> set[int]:
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            children.setdefault(int(fields[1]), []).append(int(entry.name))
+    found, todo = set(), [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.add(child)
+            todo.append(child)
+    return found
+
+
+def _alive(pids: set[int]) -> set[int]:
+    alive = set()
+    for pid in pids:
+        try:
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if state != "Z":
+            alive.add(pid)
+    return alive
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("fine", [3, 60], ids=["forked", "fork-server"])
+def test_workers_exit_when_archmetrics_is_killed(
+    repo: GitRepo, plugin: dict[str, str], fine: int
+) -> None:
+    _repo(repo, {"slow.un": "# SLEEP\n"}, fine)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "archmetrics", "scan", ".", "--no-cache", "-j", "2"],
+        cwd=repo.root,
+        env={**os.environ, **plugin},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while len(workers := _descendants(process.pid)) < 2 and time.monotonic() < deadline:
+            time.sleep(0.1)
+        time.sleep(1.0)  # the slow file is being read now
+        workers = _descendants(process.pid)
+        assert workers
+        os.kill(process.pid, signal.SIGKILL)
+        process.wait(timeout=10)
+        deadline = time.monotonic() + 20
+        while _alive(workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not _alive(workers)
+    finally:
+        if process.poll() is None:
+            process.kill()
