@@ -52,16 +52,15 @@ def _class(pattern: str, start: int) -> tuple[str, int] | None:
     return ("[^/" if negate else "[") + body + "]", end + 1
 
 
-def _segment(segment: str) -> str:
-    """Regex for one path component of a glob (``*``, ``?``, classes, escapes)."""
-    out: list[str] = []
+def _pieces(segment: str) -> list[str | None]:
+    """One path component of a glob as regex pieces, with None for each run of ``*``."""
+    out: list[str | None] = []
     i = 0
     while i < len(segment):
         char = segment[i]
         if char == "*":
-            out.append("[^/]*")
-            while i + 1 < len(segment) and segment[i + 1] == "*":
-                i += 1
+            if not out or out[-1] is not None:
+                out.append(None)
         elif char == "?":
             out.append("[^/]")
         elif char == "[" and (translated := _class(segment, i)) is not None:
@@ -73,12 +72,39 @@ def _segment(segment: str) -> str:
         else:
             out.append(re.escape(char))
         i += 1
-    return "".join(out)
+    return out
+
+
+def _segment(segment: str) -> str:
+    """Regex for one path component of a glob (``*``, ``?``, classes, escapes).
+
+    As :func:`fnmatch.translate` does, a ``*`` followed by more text and another ``*`` takes
+    the leftmost match of that text atomically (``(?>[^/]*?text)``): the next ``*`` can absorb
+    whatever a later match would have skipped, so nothing is lost, and a glob with many stars
+    is matched in time linear in their number instead of backtracking through every split."""
+    pieces = _pieces(segment)
+    stars = [i for i, piece in enumerate(pieces) if piece is None]
+    out: list[str] = []
+    for i, piece in enumerate(pieces):
+        if piece is not None:
+            continue
+        following = "".join(p for p in pieces[i + 1 : _next(stars, i, len(pieces))] if p)
+        out.append(f"(?>[^/]*?{following})" if i != stars[-1] else "[^/]*" + following)
+    head = "".join(p for p in pieces[: stars[0] if stars else len(pieces)] if p)
+    return head + "".join(out)
+
+
+def _next(stars: list[int], star: int, end: int) -> int:
+    later = [s for s in stars if s > star]
+    return later[0] if later else end
 
 
 @functools.lru_cache(maxsize=1024)
 def compile_glob(pattern: str) -> re.Pattern[str]:
-    """The regex a gitignore-like glob stands for, matched against whole relative paths."""
+    """The regex a gitignore-like glob stands for, matched against whole relative paths.
+
+    Directories work like stars: the segments between two ``**`` are matched at their
+    leftmost place atomically (see :func:`_segment`), so no glob backtracks exponentially."""
     if not pattern.strip("/") or pattern.startswith("!"):
         raise BadPattern(f"unusable glob {pattern!r} (empty, '/' or a '!' negation)")
     directory_only = pattern.endswith("/")
@@ -86,20 +112,38 @@ def compile_glob(pattern: str) -> re.Pattern[str]:
     segments = body.lstrip("/").split("/")
     if "/" not in body:
         segments = ["**", *segments]
-    parts: list[str] = []
-    for index, segment in enumerate(segments):
-        last = index == len(segments) - 1
+    segments = [s for i, s in enumerate(segments) if s != "**" or segments[i - 1 : i] != ["**"]]
+    blocks: list[list[str]] = [[]]  # the segments before the first ** and between any two
+    for segment in segments:
         if segment == "**":
-            parts.append(".+" if last else "(?:[^/]+/)*")
+            blocks.append([])
         else:
-            parts.append(_segment(segment) + ("" if last else "/"))
+            blocks[-1].append(_segment(segment))
+    regex = _blocks(blocks)
     if segments[-1] == "**":
         tail = ""
     elif directory_only:
         tail = "/.+"
     else:
         tail = "(?:/.+)?"
-    return re.compile("".join(parts) + tail)
+    try:
+        return re.compile(regex + tail)
+    except re.error as error:
+        raise BadPattern(f"unusable glob {pattern!r} ({error})") from None
+
+
+def _blocks(blocks: list[list[str]]) -> str:
+    """Regex for segment blocks separated by ``**`` (``blocks[0]`` is before the first)."""
+    parts = ["/".join(blocks[0]) + ("/" if blocks[0] and len(blocks) > 1 else "")]
+    for index, block in enumerate(blocks[1:], start=1):
+        last = index == len(blocks) - 1
+        if last and not block:  # a trailing **: everything inside
+            parts.append(".+")
+        elif last:
+            parts.append("(?:[^/]+/)*" + "/".join(block))
+        else:
+            parts.append("(?>(?:[^/]+/)*?" + "".join(f"{b}/" for b in block) + ")")
+    return "".join(parts)
 
 
 def glob_matches(pattern: str, path: str) -> bool:

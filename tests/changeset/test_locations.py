@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from archmetrics.changeset.locations import (
@@ -94,3 +96,29 @@ def test_rule_order_is_the_mapping_order() -> None:
 def test_unknown_location_name_is_named() -> None:
     with pytest.raises(BadPattern, match="'vendor'"):
         LocationRules.from_mapping({"vendor": ["third_party/**"]})
+
+
+@pytest.mark.parametrize("pattern", ["[z-a]", "src/[b-a]*.c", "**/x[9-0]"])
+def test_a_glob_regex_cannot_compile_is_refused_by_name(pattern: str) -> None:
+    with pytest.raises(BadPattern, match=re.escape(repr(pattern))):
+        LocationRules.from_mapping({"new": [pattern]})
+
+
+@pytest.mark.parametrize(
+    ("pattern", "path", "expected"),
+    [
+        ("*a" * 16 + "*b", "d/" + "a" * 400, False),
+        ("*a" * 16 + "*b", "d/" + "a" * 400 + "b", True),
+        ("*a*" * 16, "a" * 15, False),
+        ("a/" + "**/a/" * 12 + "b", "a/" * 200 + "c", False),
+        ("a/" + "**/a/" * 12 + "b", "a/" * 200 + "b", True),
+        ("**/x/**/y/**/z", "x/y/x/y/z", True),
+        ("**/x/**/y/**/z", "x/z/y", False),
+    ],
+)
+def test_globs_with_many_stars_match_without_backtracking(
+    pattern: str, path: str, expected: bool
+) -> None:
+    """Each would take longer than the test timeout if stars backtracked through every split
+    (a repository's configuration is untrusted input)."""
+    assert glob_matches(pattern, path) is expected
