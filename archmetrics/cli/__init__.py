@@ -1,13 +1,16 @@
 """The ``archmetrics`` command line: flags become a request, one use case runs, a report prints.
 
 Exit status: 0 measured (and every gate holds), 1 a gate failed, 2 could not measure (bad usage,
-unknown revision, bad configuration) with a one-line error and no traceback.
+unknown revision, bad configuration, or anything unforeseen) with a one-line error and no
+traceback (``-v`` prints it). Exit 1 means a gate failed and nothing else.
 """
 
 from __future__ import annotations
 
 import gc
+import os
 import sys
+import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
@@ -20,6 +23,7 @@ from archmetrics.cli.parser import build_parser
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
 from archmetrics.parsers import UnknownLanguage
+from archmetrics.reports.printable import one_line
 from archmetrics.sources import SourceError
 from archmetrics.sources.cache import CacheError
 from archmetrics.sources.codec import CodecError
@@ -78,14 +82,30 @@ def main(argv: Sequence[str] | None = None) -> int:
         with few_collections():
             return COMMANDS[args.command](args)
     except CANNOT_MEASURE as error:
-        print(f"archmetrics: error: {error}", file=sys.stderr)
-        return EXIT_USAGE
+        return fail(str(error))
     except CodecError as error:  # statements are decoded when first read, after the checks
-        print(
-            f"archmetrics: error: {error}; `archmetrics cache clear` empties the cache",
-            file=sys.stderr,
-        )
-        return EXIT_USAGE
+        return fail(f"{error}; `archmetrics cache clear` empties the cache")
     except KeyboardInterrupt:
         print("archmetrics: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (`archmetrics scan | head`)
+        silence_stdout()
+        return EXIT_USAGE
+    except Exception as error:  # an input nobody foresaw, or a bug: still one line, exit 2
+        if getattr(args, "verbose", False):
+            traceback.print_exc()
+        hint = "" if getattr(args, "verbose", False) else "; rerun with -v for the traceback"
+        return fail(f"unexpected {type(error).__name__}: {error} (please report it{hint})")
+
+
+def fail(message: str) -> int:
+    """Print ``message`` as the one-line error of a run that could not measure: exit 2."""
+    print(f"archmetrics: error: {one_line(message)}", file=sys.stderr)
+    return EXIT_USAGE
+
+
+def silence_stdout() -> None:
+    """Point stdout at /dev/null, so the interpreter's own flush at exit cannot fail again."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)

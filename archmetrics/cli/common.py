@@ -13,6 +13,7 @@ from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.config import Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
+from archmetrics.reports.printable import one_line
 from archmetrics.sources.cache import FactsCache, choose_path
 
 EXIT_OK, EXIT_GATE, EXIT_USAGE = 0, 1, 2
@@ -85,13 +86,26 @@ def settings_for(path: Path) -> Settings:
 
 
 def emit(text: str, output: Path | None) -> None:
+    """Write a report to ``output``, or to stdout. A file is UTF-8; stdout is written in its
+    own encoding, or as UTF-8 bytes when that encoding (ASCII, cp1252) cannot hold the
+    report's Γ, Δ and arrows: a report is never lost to an encoding."""
     if output is None:
-        sys.stdout.write(text)
+        try:
+            sys.stdout.write(text)
+        except UnicodeEncodeError:
+            sys.stdout.flush()
+            sys.stdout.buffer.write(text.encode("utf-8", "backslashreplace"))
+            sys.stdout.buffer.flush()
         return
     try:
-        output.write_text(text, encoding="utf-8")
+        output.write_text(text, encoding="utf-8", errors="backslashreplace")
     except OSError as error:
         raise UsageError(f"{output}: cannot write: {error.strerror}") from error
+
+
+def warn(message: str) -> None:
+    """A one-line warning on stderr (control characters from the measured code escaped)."""
+    print(f"archmetrics: warning: {one_line(message)}", file=sys.stderr)
 
 
 def cache_location(args: argparse.Namespace, settings: Settings) -> Path:
@@ -108,18 +122,18 @@ def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsC
         return
     with FactsCache(cache_location(args, settings)) as cache:
         for notice in cache.notices:
-            print(f"archmetrics: warning: {notice}", file=sys.stderr)
+            warn(notice)
         shown = len(cache.notices)
         try:
             yield cache
         finally:
             for notice in cache.notices[shown:]:
-                print(f"archmetrics: warning: {notice}", file=sys.stderr)
+                warn(notice)
 
 
 def gate_status(failures: Sequence[GateFailure]) -> int:
     for failure in failures:
-        print(f"archmetrics: {failure}", file=sys.stderr)
+        print(f"archmetrics: {one_line(str(failure))}", file=sys.stderr)
     return EXIT_GATE if failures else EXIT_OK
 
 

@@ -32,6 +32,7 @@ from archmetrics.reports.formats import (
 )
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources.git import tags_in_order
+from archmetrics.sources.snapshot import resolve_path
 
 
 def write_chart(args: argparse.Namespace, report: CompareReport) -> None:
@@ -144,7 +145,7 @@ def series_command(args: argparse.Namespace) -> int:
     with facts_cache(args, request.diff.settings) as cache:
         report = run_series(request, progress_for(fmt, args.quiet), cache)
     emit(render_series(report, fmt), args.output)
-    write_chart(args, CompareReport(((Path(args.repo).resolve().name, report),)))
+    write_chart(args, CompareReport(((resolve_path(Path(args.repo)).name, report),)))
     return gate_status(report.failures)
 
 
@@ -171,8 +172,6 @@ def diff_command(args: argparse.Namespace) -> int:
         report = run_diff(request, progress_for(fmt, args.quiet), cache)
     emit(render_diff(report, fmt), args.output)
     stage = Stage(f"{args.base}..{args.head}", report)
-    write_chart(
-        args,
-        CompareReport(((Path(args.repo).resolve().name, SeriesReport(str(args.repo), (stage,))),)),
-    )
+    name = resolve_path(Path(args.repo)).name
+    write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))
     return gate_status(report.failures)

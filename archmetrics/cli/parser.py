@@ -59,6 +59,9 @@ def build_parser() -> argparse.ArgumentParser:
         "Docs: docs/metrics.md (what is counted), docs/json.md (the JSON contract).",
     )
     parser.add_argument("--version", action="version", version=f"archmetrics {__version__}")
+    parser.add_argument(
+        "-v", "--verbose", action="store_true", help="print the traceback of an unexpected error"
+    )
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     scan = commands.add_parser(
         "scan", help="λ, SLOC, v_g per file and function; coupling per element; every link"
@@ -137,4 +140,12 @@ def build_parser() -> argparse.ArgumentParser:
     cache = commands.add_parser("cache", help="the facts cache: where it is, how big; clear it")
     cache.add_argument("action", choices=["info", "clear"])
     cache.add_argument("--cache-path", type=Path, help="the facts cache file")
+    for command in commands.choices.values():  # -v also after the command's name
+        command.add_argument(
+            "-v",
+            "--verbose",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help=argparse.SUPPRESS,
+        )
     return parser

@@ -7,6 +7,7 @@ from enum import StrEnum
 
 from archmetrics.reports import csv_report, json_report, markdown_report, table_report
 from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
+from archmetrics.reports.printable import printable
 
 
 class OutputFormat(StrEnum):
@@ -36,8 +37,14 @@ _SCAN: dict[OutputFormat, ScanRenderer] = {
 assert set(_SCAN) == set(OutputFormat), "every output format needs a scan renderer"
 
 
+def _safe(fmt: OutputFormat, text: str) -> str:
+    """JSON escapes control characters itself; every other format goes through
+    :func:`~archmetrics.reports.printable.printable`."""
+    return text if fmt is OutputFormat.JSON else printable(text)
+
+
 def render_scan(report: ScanReport, fmt: OutputFormat, grouping: Grouping) -> str:
-    return _SCAN[fmt](report, grouping.value)
+    return _safe(fmt, _SCAN[fmt](report, grouping.value))
 
 
 _DIFF: dict[OutputFormat, Callable[[DiffReport], str]] = {
@@ -50,7 +57,7 @@ assert set(_DIFF) == set(OutputFormat), "every output format needs a diff render
 
 
 def render_diff(report: DiffReport, fmt: OutputFormat) -> str:
-    return _DIFF[fmt](report)
+    return _safe(fmt, _DIFF[fmt](report))
 
 
 _SERIES: dict[OutputFormat, Callable[[SeriesReport], str]] = {
@@ -69,8 +76,8 @@ assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs s
 
 
 def render_series(report: SeriesReport, fmt: OutputFormat) -> str:
-    return _SERIES[fmt](report)
+    return _safe(fmt, _SERIES[fmt](report))
 
 
 def render_compare(report: CompareReport, fmt: OutputFormat) -> str:
-    return _COMPARE[fmt](report)
+    return _safe(fmt, _COMPARE[fmt](report))

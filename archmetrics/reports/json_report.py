@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from typing import Any
 
 from archmetrics.complexity import FileMetrics, Totals
@@ -76,8 +77,15 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
     }
 
 
+_UNPRINTABLE = re.compile(r"[\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+
+
 def dumps(document: dict[str, Any]) -> str:
-    return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
+    """The document as JSON text. ``json`` escapes C0 controls itself; DEL, C1 controls, line
+    separators and lone surrogates are escaped here too (``\\u0085``), so the text is valid
+    UTF-8 and safe to print (docs/security.md)."""
+    text = json.dumps(document, indent=2, ensure_ascii=False) + "\n"
+    return _UNPRINTABLE.sub(lambda found: f"\\u{ord(found.group()):04x}", text)
 
 
 def render_scan(report: ScanReport) -> str:

@@ -17,6 +17,7 @@ from pathlib import Path
 import git
 from git.exc import GitCommandError, GitError, InvalidGitRepositoryError, NoSuchPathError
 
+from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import (
     EMPTY,
     INDEX,
@@ -177,7 +178,7 @@ class RevisionSnapshot(_BlobReader):
             meta, path = entry.split("\t", 1)
             mode, kind, blob = meta.split(" ")
             if kind == "blob" and mode != "120000":  # skip symlinks and submodules
-                found.append(SourceFile(path, blob))
+                found.append(SourceFile(quote_path(path), blob))
         return tuple(sorted(found))
 
 
@@ -193,7 +194,7 @@ class IndexSnapshot(_BlobReader):
             mode, blob, stage = meta.split(" ")
             if mode == "120000" or mode == "160000" or stage not in ("0", "2"):
                 continue
-            found[path] = SourceFile(path, blob)
+            found[path] = SourceFile(quote_path(path), blob)
         return tuple(sorted(found.values()))
 
 
@@ -237,7 +238,7 @@ def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:
     for i in range(0, len(fields) - 2, 3):
         status, old, new = fields[i : i + 3]
         if status.startswith("R"):
-            pairs[old] = new
+            pairs[quote_path(old)] = quote_path(new)
     return pairs
 
 

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+from archmetrics.sources.paths import quote_path
+
 EMPTY = "EMPTY"  # the empty tree: a first integration stage has nothing before it
 WORKTREE = "WORKTREE"  # the files on disk, committed or not (untracked ones too, unless ignored)
 INDEX = "INDEX"  # what is staged
@@ -24,7 +26,8 @@ class SourceError(Exception):
 
 @dataclass(frozen=True, slots=True, order=True)
 class SourceFile:
-    """A file in a snapshot: its path (POSIX, relative to the snapshot's root) and blob hash."""
+    """A file in a snapshot: its path (POSIX, relative to the snapshot's root, quoted as
+    :func:`~archmetrics.sources.paths.quote_path` says) and blob hash."""
 
     path: str
     blob: str
@@ -39,6 +42,15 @@ class Snapshot(Protocol):
     def files(self) -> tuple[SourceFile, ...]: ...
 
     def read(self, file: SourceFile) -> bytes: ...
+
+
+def resolve_path(path: Path) -> Path:
+    """``path`` made absolute with symbolic links resolved; a loop or an unreadable folder
+    is a one-line :class:`SourceError`."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError) as error:  # 3.11 raises RuntimeError for a link loop
+        raise SourceError(f"{path}: cannot resolve: {error}") from error
 
 
 def blob_hash(data: bytes) -> str:
@@ -69,6 +81,7 @@ class DirectorySnapshot:
         self.label = label
         self._paths = tuple(sorted(paths)) if paths is not None else None
         self._hashes: dict[str, str] = {}
+        self._on_disk: dict[str, str] = {}  # quoted name -> the name on disk, where they differ
 
     def _walk(self) -> Iterable[str]:
         if self._paths is not None:
@@ -85,12 +98,15 @@ class DirectorySnapshot:
         for path in self._walk():
             full = self.root / path
             if full.is_file() and not full.is_symlink():
-                found.append(SourceFile(path, self._hashes.get(path, "")))
+                shown = quote_path(path)
+                if shown != path:
+                    self._on_disk[shown] = path
+                found.append(SourceFile(shown, self._hashes.get(path, "")))
         return tuple(found)
 
     def read(self, file: SourceFile) -> bytes:
         try:
-            return (self.root / file.path).read_bytes()
+            return (self.root / self._on_disk.get(file.path, file.path)).read_bytes()
         except OSError as error:
             raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
 
