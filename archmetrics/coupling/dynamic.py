@@ -17,6 +17,7 @@ from functools import lru_cache
 
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
+from archmetrics.coupling.patterns import SlowPattern, search
 from archmetrics.coupling.rules import (
     EndpointSource,
     EndpointSpec,
@@ -157,7 +158,7 @@ def _key_from(
         raise AmbiguousEndpoint(f"{argument.text}: {via}")
     if spec.pattern is not None:
         subject = value if isinstance(value, str) else argument.text
-        found = re.search(spec.pattern, subject)
+        found = search(spec.pattern, subject)
         value = (found.group(1) if found.groups() else found.group(0)) if found else None
     key = normalize(spec.type, value) if value is not None else None
     return Endpoint(key, argument.text, via) if key else None
@@ -172,7 +173,7 @@ def _first_matching(call: CallSite, spec: EndpointSpec, read: ArgumentReader) ->
 
 
 def _from_callee(callee: str, spec: EndpointSpec) -> Endpoint | None:
-    found = re.search(spec.pattern or "", callee)
+    found = search(spec.pattern or "", callee)
     if not found:
         return None
     key = normalize(spec.type, found.group(1) if found.groups() else found.group(0))
@@ -199,8 +200,8 @@ def read_endpoint(
     """The endpoint of a matched call as its rule's spec says (None if unknown), and a note."""
     try:
         return _read_endpoint(call, spec, calls, read), ""
-    except AmbiguousEndpoint as several:
-        return None, str(several)
+    except (AmbiguousEndpoint, SlowPattern) as unknown:
+        return None, str(unknown)
 
 
 def _read_endpoint(
@@ -247,8 +248,14 @@ def file_link_sites(
     for function in facts.functions:
         if rule := definitions.choose(function.qualified_name):
             spec, name = rule.endpoint, function.qualified_name
-            endpoint = _from_callee(name, spec) if spec and spec.pattern else None
-            found.append((rule, _site(facts.path, function.span.start, rule, name, endpoint, name)))
+            endpoint, note = None, ""
+            if spec and spec.pattern:
+                try:
+                    endpoint = _from_callee(name, spec)
+                except SlowPattern as slow:
+                    note = str(slow)
+            site = _site(facts.path, function.span.start, rule, name, endpoint, name)
+            found.append((rule, replace(site, note=note)))
     sites = [_from_file(rule, site, found) for rule, site in found]
     return tuple(sorted(sites, key=lambda s: (s.line, s.rule)))
 

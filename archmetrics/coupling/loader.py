@@ -9,6 +9,7 @@ Packs come from three places, in this order: the built-in packs shipped in
 from __future__ import annotations
 
 import os
+import stat
 import tomllib
 from collections.abc import Iterable
 from importlib import metadata, resources
@@ -34,14 +35,33 @@ def load_rule_pack(source: PackSource) -> RulePack:
     """Read and validate one pack; any problem is a :class:`RulePackError` naming the file."""
     name = str(source)
     try:
-        text = (source if isinstance(source, Traversable) else Path(source)).read_text("utf-8")
+        if isinstance(source, str | os.PathLike):  # a file, not a resource in a package
+            source = Path(source)
+            if _regular_file_size(source) > MAX_PACK_BYTES:
+                raise RulePackError(name, None, None, f"larger than {MAX_PACK_BYTES} bytes")
+        text = source.read_text("utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise RulePackError(name, None, None, f"cannot read the pack: {error}") from error
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise RulePackError(name, None, None, f"not valid TOML: {error}") from error
+    except RecursionError:
+        raise RulePackError(name, None, None, "not valid TOML: nested too deeply") from None
     return parse_pack(data, name)
+
+
+MAX_PACK_BYTES = 1 << 20
+"""A rule pack larger than this (1 MiB) is refused: packs are a few kilobytes."""
+
+
+def _regular_file_size(path: Path) -> int:
+    """The size of ``path``; OSError unless it is a regular file (a FIFO or ``/dev/zero``
+    would never finish reading)."""
+    info = path.stat()
+    if not stat.S_ISREG(info.st_mode):
+        raise OSError(f"{path}: not a regular file")
+    return info.st_size
 
 
 def _is_source(value: object) -> bool:

@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NoReturn
 
+from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
     KNOWN_LANGUAGES,
@@ -179,8 +180,8 @@ def _endpoint_fields(where: _Where, table: Mapping[str, object]) -> EndpointSpec
         if not isinstance(pattern, str):
             where.fail("pattern", "must be a string")
         try:
-            re.compile(pattern)
-        except re.error as error:
+            compile_pattern(pattern)
+        except PatternError as error:
             where.fail("pattern", f"bad regular expression: {error}")
     hints = table.get("same_function", [])
     if not isinstance(hints, list):

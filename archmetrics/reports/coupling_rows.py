@@ -28,7 +28,8 @@ def _static_target(dep: StaticDependency) -> str:
 
 
 def _dynamic_target(site: LinkSite) -> str:
-    endpoint = site.endpoint.key if site.endpoint else "?"
+    unknown = "?" + (f" ({site.note})" if site.note else "")
+    endpoint = site.endpoint.key if site.endpoint else unknown
     return endpoint + (f" → {', '.join(site.targets)}" if site.targets else "")
 
 
@@ -92,6 +93,7 @@ def site_dict(site: LinkSite) -> dict[str, Any]:
         "status": str(site.status),
         "targets": list(site.targets),
         "function": site.function,
+        "note": site.note or None,
     }
 
 
