@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from typing import TextIO
 
 from robosoa.descriptor import DescriptorError, Packaging, load
+from robosoa.descriptor.loader import MAX_DESCRIPTOR_BYTES
 
 from .generate import CodegenError, generate, write
 
@@ -30,13 +31,17 @@ def _parser() -> argparse.ArgumentParser:
     )
     check = sub.add_parser("validate", help="check a descriptor against schema and semantics")
     check.add_argument("descriptor", help="service descriptor (XML)")
+    for command in (gen, check):
+        command.add_argument("--max-size", type=int, default=MAX_DESCRIPTOR_BYTES,
+                             metavar="BYTES", help="refuse larger descriptor files "
+                             f"(default {MAX_DESCRIPTOR_BYTES})")
     return parser
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Execute parsed ``args``; report to ``out``/``err``; return the exit code."""
     try:
-        descriptor = load(args.descriptor)
+        descriptor = load(args.descriptor, max_bytes=args.max_size)
         if args.command == "validate":
             names = ", ".join(op.name for op in descriptor.operations)
             print(

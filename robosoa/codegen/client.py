@@ -67,7 +67,7 @@ def _listen(d: ServiceDescriptor, op: Operation, checked: bool) -> list[str]:
     value = f"{kind}.from_payload(message.payload)" if kind else ""
     lines += [f"            callback({value})", ""]
     listen = "on" if event else "subscribe"
-    return [*lines, f'        return self._bus.{listen}(f"{{SERVICE}}.{op.name}", deliver)']
+    return [*lines, f"        return self._bus.{listen}(SERVICE + {q('.' + op.name)}, deliver)"]
 
 
 def _init(d: ServiceDescriptor, part: Participant, checked: bool) -> list[str]:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import PurePath
@@ -13,6 +12,7 @@ from robosoa.descriptor import Operation, Parameter, ServiceDescriptor, TypeDef
 from .pytypes import (
     default_literal,
     keyword_lines,
+    literal_lines,
     message_class,
     q,
     result_class,
@@ -35,25 +35,68 @@ def source_name(d: ServiceDescriptor) -> str:
     return PurePath(d.source).name
 
 
+def marker(d: ServiceDescriptor) -> str:
+    """The first line of every generated file; a file name that is not plain printable text
+    (line breaks, controls) is cited as its ``repr``, so the comment stays one line."""
+    name = source_name(d)
+    return MARKER.format(source=name if name.isprintable() else repr(name))
+
+
 def header(d: ServiceDescriptor, summary: str, details: str = "") -> list[str]:
     """Marker line and module docstring."""
-    lines = [MARKER.format(source=source_name(d)), f'"""{escape(summary)}']
+    first, *rest = doc_lines(summary, 96) or [""]
+    lines = [marker(d), f'"""{first}', *rest]
     if not details:
+        if rest:
+            return [*lines, '"""', ""]
         return [lines[0], f'{lines[1]}"""', ""]
-    lines += ["", *textwrap.wrap(escape(details), 96)]
+    lines += ["", *doc_lines(details, 96)]
     return [*lines, '"""', ""]
 
 
-def escape(text: str) -> str:
-    """Text safe inside a triple-quoted docstring."""
-    return text.replace("\\", "\\\\").replace('"""', '\\"\\"\\"')
+def _escaped(char: str) -> str:
+    """One character as it may appear inside a docstring: never a quote or a bare backslash."""
+    if char in '"\\':
+        return "\\" + char
+    return char if char.isprintable() else repr(char)[1:-1]
+
+
+def _pieces(word: str, width: int) -> list[str]:
+    """An escaped word, cut into pieces of at most ``width`` columns between escapes."""
+    pieces = [""]
+    for char in word:
+        atom = _escaped(char)
+        if pieces[-1] and len(pieces[-1]) + len(atom) > width:
+            pieces.append("")
+        pieces[-1] += atom
+    return pieces
+
+
+def doc_lines(text: str, width: int) -> list[str]:
+    """``text`` as docstring lines of at most ``width`` columns.
+
+    Every run of whitespace (line breaks of any kind included) becomes one space or a line
+    break; backslashes, double quotes and unprintable characters are escaped, and a line never
+    ends inside an escape, so no text can end the docstring early.
+    """
+    lines: list[str] = []
+    line = ""
+    for word in text.split():
+        for piece in _pieces(word, width):
+            if line and len(line) + 1 + len(piece) <= width:
+                line += " " + piece
+            else:
+                if line:
+                    lines.append(line)
+                line = piece
+    return [*lines, line] if line else lines
 
 
 def docstring(indent: str, text: str, notes: list[str] | None = None) -> list[str]:
     """A docstring at ``indent``, wrapped to fit 99 columns."""
     width = 96 - len(indent)
-    body = textwrap.wrap(escape(text), width) or [""]
-    extra = [n for note in notes or [] for n in textwrap.wrap(escape(note), width)]
+    body = doc_lines(text, width) or [""]
+    extra = [n for note in notes or [] for n in doc_lines(note, width)]
     if len(body) == 1 and not extra and len(body[0]) + len(indent) + 6 <= 99:
         return [f'{indent}"""{body[0]}"""']
     lines = [f'{indent}"""{body[0]}', *(f"{indent}{b}" for b in body[1:])]
@@ -125,7 +168,8 @@ def render_types(d: ServiceDescriptor) -> str:
         "",
         "# The descriptor this package was generated from; payloads are checked against it.",
         *_string_constant("DESCRIPTOR_XML", d.text),
-        f"DESCRIPTOR: ServiceDescriptor = loads(DESCRIPTOR_XML, source={q(source_name(d))})",
+        *literal_lines("DESCRIPTOR: ServiceDescriptor = loads(DESCRIPTOR_XML, source=",
+                       source_name(d), ")"),
     ]
     for t in d.types:
         body += _struct(t)

@@ -6,21 +6,14 @@ import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
-from robosoa.descriptor import (
-    Actor,
-    Packaging,
-    Participant,
-    Profile,
-    ServiceDescriptor,
-)
-from robosoa.descriptor.loader import default_naming
-from robosoa.descriptor.model import Language, OperatingSystem
+from robosoa.descriptor import Packaging, Participant, ServiceDescriptor
+from robosoa.descriptor.errors import one_line
+from robosoa.descriptor.names import camel, default_consumer
 
 from .api import render_api, render_init
 from .client import render_client
 from .common import GeneratedFile, header, render_types
 from .provider import render_provider
-from .pytypes import camel
 
 
 class CodegenError(ValueError):
@@ -29,18 +22,8 @@ class CodegenError(ValueError):
 
 def _default_participant(d: ServiceDescriptor, packaging: Packaging) -> Participant:
     if packaging is not Packaging.CONSUMER_SOURCE:
-        raise CodegenError(f"{d.source}: declares no '{packaging}' participant")
-    return Participant(
-        actor=Actor.CONSUMER,
-        packaging=packaging,
-        language=Language.PYTHON,
-        os=OperatingSystem.ANY,
-        implementation=None,
-        profile=Profile.CHECKED,
-        naming=default_naming(d.name, packaging, None),
-        group=None,
-        line=d.line,
-    )
+        raise CodegenError(f"{one_line(d.source)}: declares no '{packaging}' participant")
+    return default_consumer(d)
 
 
 def participants(d: ServiceDescriptor, forms: Sequence[Packaging] = ()) -> list[Participant]:
@@ -84,7 +67,7 @@ def generate(d: ServiceDescriptor, forms: Sequence[Packaging] = ()) -> tuple[Gen
     for part in participants(d, forms):
         for f in generate_participant(d, part):
             if f.path in files:
-                raise CodegenError(f"{d.source}: two participants generate {f.path}")
+                raise CodegenError(f"{one_line(d.source)}: two participants generate {f.path}")
             files[f.path] = f
     return tuple(files.values())
 
@@ -92,8 +75,11 @@ def generate(d: ServiceDescriptor, forms: Sequence[Packaging] = ()) -> tuple[Gen
 def write(files: Sequence[GeneratedFile], out: str | Path) -> list[Path]:
     """Write ``files`` under directory ``out``; return the paths written."""
     written = []
+    root = Path(out).resolve()
     for f in files:
         path = Path(out) / f.path
+        if not path.resolve().is_relative_to(root):  # names are checked; this is a backstop
+            raise CodegenError(f"{f.path}: outside the output directory {out}")
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(f.text, encoding="utf-8")
         written.append(path)

@@ -39,7 +39,7 @@ def _protocol(d: ServiceDescriptor, name: str) -> list[str]:
 
 
 def _handler(op: Operation) -> list[str]:
-    lines = [f"    def _{op.name}(self, **payload: Any) -> dict[str, Any]:"]
+    lines = [f"    def _serve_{op.name}(self, **payload: Any) -> dict[str, Any]:"]
     args = [f"{p.name}={field_from(p, 'payload')}" for p in op.parameters]
     invoke = f"self._impl.{op.name}({', '.join(args)})"
     if len(f"        result = {invoke}") > 99:
@@ -58,7 +58,10 @@ def _handler(op: Operation) -> list[str]:
 def _skeleton(d: ServiceDescriptor, part: Participant, protocol: str) -> list[str]:
     name = part.naming.class_name
     text = f"Provider skeleton of '{d.name}' {d.version}: serves it by calling the implementation."
-    table = ", ".join(f"{q(op.name)}: self._{op.name}" for op in d.operations)
+    entries = [f"{q(op.name)}: self._serve_{op.name}" for op in d.operations]
+    table = [f"            {{{', '.join(entries)}}},"]
+    if len(table[0]) > 99:
+        table = ["            {", *(f"                {e}," for e in entries), "            },"]
     validator = "DESCRIPTOR.validator()" if part.profile is Profile.CHECKED else "None"
     lines = [f"class {name}:", *docstring("    ", text), ""]
     lines += [
@@ -70,7 +73,7 @@ def _skeleton(d: ServiceDescriptor, part: Participant, protocol: str) -> list[st
         '        """Offer the service on ``bus``; close the returned handle to withdraw it."""',
         "        return bus.provide(",
         "            SERVICE,",
-        f"            {{{table}}},",
+        *table,
         "            version=VERSION,",
         "            operations=OPERATIONS,",
         f"            pattern={q(_BUS_PATTERN.get(d.pattern, d.pattern.value))},",
@@ -139,7 +142,7 @@ def _publisher(d: ServiceDescriptor, part: Participant) -> list[str]:
         lines.append(f"        payload = payload_of({{{items}}})")
         if part.profile is Profile.CHECKED:
             lines.append(f"        self._check({q(op.name)}, payload)")
-        lines.append(f'        self._bus.{verb}(f"{{SERVICE}}.{op.name}", payload)')
+        lines.append(f"        self._bus.{verb}(SERVICE + {q('.' + op.name)}, payload)")
     return lines
 
 

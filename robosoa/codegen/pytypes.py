@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
-import json
-
-from robosoa.descriptor import Operation, Parameter, TypeRef
+from robosoa.descriptor import Operation, Parameter, TypeRef, names
 from robosoa.descriptor.checks import default_value
 
 _PRIMITIVE = {"int": "int", "float": "float", "bool": "bool", "string": "str"}
 
 
 def q(value: object) -> str:
-    """A Python literal of ``value``, strings in double quotes as ruff format writes them."""
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    return repr(value)
+    """A Python literal of ``value``: always ``repr``, so any string is escaped correctly.
+
+    A string ``repr`` puts in single quotes that holds no quote character at all is given
+    double quotes instead (as ruff format writes it); nothing inside changes.
+    """
+    literal = repr(value)
+    if isinstance(value, str) and literal[0] == "'" and '"' not in value:
+        return f'"{literal[1:-1]}"'
+    return literal
 
 
 def literal_lines(head: str, value: str, tail: str = "") -> list[str]:
@@ -39,19 +42,14 @@ def literal_lines(head: str, value: str, tail: str = "") -> list[str]:
     return [f"{head}(", *(f"{indent}{q(p)}" for p in pieces), f"{indent[:-4]}){tail}"]
 
 
-def camel(name: str) -> str:
-    """``world_db`` -> ``WorldDb``: class names from service and operation names."""
-    return "".join(part[:1].upper() + part[1:] for part in name.split("_"))
-
-
 def result_class(op: Operation) -> str:
     """Name of the generated dataclass holding the return values of ``op``."""
-    return f"{camel(op.name)}Result"
+    return names.result_class(op.name)
 
 
 def message_class(op: Operation) -> str:
     """Name of the generated dataclass holding the parameters of a topic or event ``op``."""
-    return f"{camel(op.name)}Message"
+    return names.message_class(op.name)
 
 
 def annotation(t: TypeRef) -> str:

@@ -21,6 +21,8 @@ from typing import Any
 import robosoa
 from robosoa.codegen import xmlcodec
 from robosoa.descriptor import Encoding, ServiceDescriptor
+from robosoa.errors import InvalidMessage
+from robosoa.wire import LimitExceeded, load_json, load_object
 
 _PLATFORMS = {
     "linux": ("linux",),
@@ -103,10 +105,11 @@ class ExecutableRunner:
             return {returns[0].name: output.decode()}
         if self._encoding is Encoding.XML:
             return xmlcodec.decode_result(self._descriptor, returns, output)
-        data = json.loads(output.decode() or "{}")
-        if not isinstance(data, dict):
-            raise RuntimeError(f"{operation}: the program must print a JSON object")
-        return data
+        try:
+            return load_object(output or b"{}")
+        except InvalidMessage as exc:
+            why = f"{operation}: the program must print a JSON object ({exc})"
+            raise RuntimeError(why) from None
 
 
 def serve_main(
@@ -143,8 +146,10 @@ def _argument(descriptor: ServiceDescriptor, operation: str, item: str) -> tuple
     if declared is not None and declared.type.name == "string":
         return name, text
     try:
-        return name, json.loads(text)
-    except json.JSONDecodeError:
+        return name, load_json(text)
+    except LimitExceeded as exc:
+        raise ValueError(f"argument {name!r}: {exc}") from None
+    except InvalidMessage:
         return name, text
 
 

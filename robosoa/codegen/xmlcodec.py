@@ -74,8 +74,12 @@ def decode_result(
     d: ServiceDescriptor, returns: Sequence[Parameter], document: bytes
 ) -> dict[str, Any]:
     """The reply payload read from a program's XML result document."""
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
+                             huge_tree=False)
     try:
-        root = etree.fromstring(document, etree.XMLParser(resolve_entities=False))
+        root = etree.fromstring(document, parser)
     except etree.XMLSyntaxError as exc:
         raise ValueError(f"result is not XML: {exc}") from None
+    if root.getroottree().docinfo.internalDTD is not None:
+        raise ValueError("result has a DTD: not allowed")
     return _fields(d, returns, root, "")

@@ -5,12 +5,12 @@ Pure: takes a :class:`ServiceDescriptor`, returns problems, never raises or read
 
 from __future__ import annotations
 
-import keyword
+import math
+import shlex
 from collections.abc import Iterator, Sequence
 
 from .errors import Problem
 from .model import (
-    PRIMITIVES,
     Actor,
     ImplementationForm,
     Language,
@@ -22,8 +22,9 @@ from .model import (
     ServiceDescriptor,
     TypeRef,
 )
+from .names import name_problems
 
-_RESERVED = frozenset({"self", "list", *PRIMITIVES})
+MAX_TIMEOUT = 86_400  # seconds a provider program may be given (one day)
 _PUBSUB_FORMS = (Packaging.PROVIDER_LIBRARY, Packaging.CONSUMER_SOURCE)
 _FORMS = {
     Packaging.PROVIDER_EXECUTABLE: (ImplementationForm.EXECUTABLE,),
@@ -36,7 +37,7 @@ _FORMS = {
 def check(d: ServiceDescriptor) -> list[Problem]:
     """All semantic problems of ``d``, in document order."""
     found = [
-        *_names(d),
+        *name_problems(d),
         *_duplicates(d),
         *_types(d),
         *_defaults(d),
@@ -56,16 +57,6 @@ def _members(d: ServiceDescriptor) -> Iterator[tuple[str, Parameter]]:
             yield f"operation '{op.name}' parameter '{p.name}'", p
         for r in op.returns:
             yield f"operation '{op.name}' return '{r.name}'", r
-
-
-def _names(d: ServiceDescriptor) -> Iterator[Problem]:
-    named: list[tuple[str, str, int]] = [("service", d.name, d.line)]
-    named += [(f"operation '{op.name}'", op.name, op.line) for op in d.operations]
-    named += [(f"type '{t.name}'", t.name, t.line) for t in d.types]
-    named += [(label, p.name, p.line) for label, p in _members(d)]
-    for label, name, line in named:
-        if keyword.iskeyword(name) or name in _RESERVED:
-            yield Problem(d.source, line, label, f"'{name}' is a reserved word")
 
 
 def _dupes(source: str, label: str, items: Sequence[tuple[str, int]]) -> Iterator[Problem]:
@@ -125,7 +116,8 @@ def default_value(t: TypeRef, text: str) -> int | float | bool | str | None:
         if t.name == "int":
             return int(text)
         if t.name == "float":
-            return float(text)
+            value = float(text)
+            return value if math.isfinite(value) else None
     except ValueError:
         return None
     if t.name == "bool":
@@ -201,6 +193,7 @@ def _implementation(d: ServiceDescriptor, part: Participant, label: str) -> Iter
         if name is not None and d.operation(name) is None:
             yield Problem(d.source, line, here, f"unknown operation '{name}'")
     if impl.form is ImplementationForm.EXECUTABLE:
+        yield from _commands(d, part, here)
         for op in d.operations:
             if impl.command(op.name) is None:
                 yield Problem(d.source, impl.line, here, f"no command for operation '{op.name}'")
@@ -216,6 +209,23 @@ def _implementation(d: ServiceDescriptor, part: Participant, label: str) -> Iter
             yield Problem(d.source, part.line, label, "language 'c' needs provider-library")
         for op in d.operations:
             yield from _c_operation(d, op, here)
+
+
+def _commands(d: ServiceDescriptor, part: Participant, here: str) -> Iterator[Problem]:
+    impl = part.implementation
+    assert impl is not None
+    if not 0 < impl.timeout <= MAX_TIMEOUT:
+        yield Problem(d.source, impl.line, here, f"timeout must be 1 to {MAX_TIMEOUT} seconds")
+    for command in impl.commands:
+        try:
+            words = shlex.split(command.argv)
+        except ValueError as exc:
+            words, why = [], f": {exc}"
+        else:
+            why = ""
+        if not words:
+            yield Problem(d.source, command.line, f"{here} command",
+                          f"not a command line{why or ': empty'}")
 
 
 def _text_encoding(d: ServiceDescriptor, op: Operation, line: int, here: str) -> Iterator[Problem]:

@@ -16,8 +16,16 @@ class Problem:
     message: str
 
     def __str__(self) -> str:
+        """One line, whatever the descriptor (or its file name) contains."""
         where = f"{self.field}: " if self.field else ""
-        return f"{self.source}:{self.line}: {where}{self.message}"
+        return one_line(f"{self.source}:{self.line}: {where}{self.message}")
+
+
+def one_line(text: str) -> str:
+    """``text`` with every unprintable character (line breaks included) escaped as in repr."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 class DescriptorError(ValueError):

@@ -6,7 +6,9 @@ Semantic checks live in :mod:`robosoa.descriptor.checks`; this module only turns
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 from collections.abc import Iterable
 from functools import cache
 from importlib import resources
@@ -37,6 +39,7 @@ from .model import (
     TypeDef,
     TypeRef,
 )
+from .names import default_naming
 
 _Element = etree._Element
 
@@ -49,6 +52,8 @@ _LABELS = {
     "command": "command",
     "function": "function",
 }
+_DECLARATION = re.compile(r"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
+MAX_DESCRIPTOR_BYTES = 1024 * 1024  # a descriptor is a page of XML; 1 MiB is plenty
 _SCHEMA_PREFIX = re.compile(r"^Element '[^']+'(?:, attribute '(?P<attr>[^']+)')?: ")
 
 
@@ -59,27 +64,66 @@ def schema() -> etree.XMLSchema:
     return etree.XMLSchema(etree.fromstring(data))
 
 
-def load(path: str | Path) -> ServiceDescriptor:
-    """Load and validate the descriptor file at ``path``; raise :class:`DescriptorError`."""
+def load(path: str | Path, max_bytes: int = MAX_DESCRIPTOR_BYTES) -> ServiceDescriptor:
+    """Load and validate the descriptor file at ``path``; raise :class:`DescriptorError`.
+
+    Only a regular file of at most ``max_bytes`` bytes of UTF-8 is read.
+    """
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise OSError("not a regular file")
+        with open(path, "rb") as stream:
+            data = stream.read(max_bytes + 1)
+        if len(data) > max_bytes:
+            raise OSError(f"larger than {max_bytes} bytes (the descriptor size limit)")
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise DescriptorError([Problem(str(path), 0, "", f"cannot read: {exc}")]) from None
-    return loads(text, source=str(path))
+    text = text.replace("\r\n", "\n").replace("\r", "\n")  # as text mode reads it
+    return loads(text, source=str(path), max_bytes=max_bytes)
 
 
-def loads(text: str, source: str = "<descriptor>") -> ServiceDescriptor:
-    """Parse and validate descriptor ``text``; ``source`` names it in error messages."""
-    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+def _refuse(source: str, line: int, message: str) -> DescriptorError:
+    return DescriptorError([Problem(source, line, "", message)])
+
+
+def _parse(text: str, source: str, max_bytes: int) -> _Element:
+    """The document's root, parsed without DTDs, entities or network access."""
     try:
-        root = etree.fromstring(text.encode("utf-8"), parser)
+        data = text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise _refuse(source, 0, f"cannot be encoded as UTF-8: {exc.reason}") from None
+    if len(data) > max_bytes:
+        raise _refuse(source, 0, f"larger than {max_bytes} bytes (the descriptor size limit)")
+    found = _DECLARATION.search(text)
+    if found:
+        line = text.count("\n", 0, found.start()) + 1
+        raise _refuse(source, line, "DTDs and entity declarations are not allowed")
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
+                             huge_tree=False, dtd_validation=False)
+    try:
+        root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
-        line = exc.lineno or 0
-        raise DescriptorError(
-            [Problem(source, line, "", f"not well-formed XML: {exc.msg}")]
-        ) from None
+        raise _refuse(source, exc.lineno or 0, f"not well-formed XML: {exc.msg}") from None
+    docinfo = root.getroottree().docinfo
+    doctype: object = getattr(docinfo, "doctype", "")  # the lxml stubs leave it out
+    entity = next(root.iter(etree.Entity), None)
+    if doctype or docinfo.internalDTD is not None or entity is not None:
+        line = _line(entity) if entity is not None else 1
+        raise _refuse(source, line, "DTDs and entity references are not allowed")
+    return root
+
+
+def loads(text: str, source: str = "<descriptor>",
+          max_bytes: int = MAX_DESCRIPTOR_BYTES) -> ServiceDescriptor:
+    """Parse and validate descriptor ``text``; ``source`` names it in error messages."""
+    root = _parse(text, source, max_bytes)
     validator = schema()
-    if not validator.validate(root):
+    try:
+        valid = validator.validate(root)
+    except etree.Error as exc:  # lxml refuses some documents outright
+        raise _refuse(source, 0, f"cannot be checked against the schema: {exc}") from None
+    if not valid:
         raise DescriptorError(_schema_problems(root, validator, source))
     descriptor = _service(root, source, text)
     problems = check(descriptor)
@@ -198,17 +242,6 @@ def _implementation(element: _Element | None) -> Implementation | None:
         ),
         line=_line(element),
     )
-
-
-def default_naming(service: str, packaging: Packaging, library: str | None) -> Naming:
-    """Package, module and class names used when ``<naming>`` leaves them out."""
-    camel = "".join(part[:1].upper() + part[1:] for part in service.split("_"))
-    if packaging is Packaging.CONSUMER_SOURCE:
-        return Naming(f"{service}_client", "client", f"{camel}Client")
-    if packaging is Packaging.CONSUMER_NO_SOURCE:
-        package = library.rsplit(".", 1)[-1] if library else f"{service}_api"
-        return Naming(package, "api", f"{camel}Api")
-    return Naming(f"{service}_provider", "provider", f"{camel}Provider")
 
 
 def _naming(element: _Element | None, defaults: Naming) -> Naming:
