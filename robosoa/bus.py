@@ -21,7 +21,7 @@ from robosoa.errors import (
     RobosoaError,
     ServiceNotFound,
 )
-from robosoa.location import ServiceInfo
+from robosoa.location import PATTERNS, ServiceInfo
 from robosoa.message import (
     Kind,
     Message,
@@ -33,11 +33,10 @@ from robosoa.message import (
 )
 from robosoa.provider import ERROR_EVENT, ProviderHandle
 from robosoa.registrar import Registrar
-from robosoa.stats import Counter, ServiceFigures, StatsBook
+from robosoa.stats import Counter, ServiceFigures
 from robosoa.subscription import Callback, Subscription
 from robosoa.transports.base import BusOptions, ProtocolAdapter, Unreachable
 
-PATTERNS = ("request-response", "oneway", "publish-subscribe", "event", "point-to-point")
 TARGETS = ("one", "group", "all")
 ASYNC_WORKERS = 8  # asynchronous requests run on this many threads per bus
 
@@ -48,7 +47,7 @@ class Bus:
     def __init__(self, adapter: ProtocolAdapter, options: BusOptions | None = None) -> None:
         self.adapter = adapter
         self.options = options or adapter.options
-        self.stats_book = StatsBook()
+        self.stats_book = adapter.stats_book
         self._subscriptions: list[Subscription] = []
         self.directory = Directory(adapter, self.options)
         self._consumers: dict[str, Counter] = {}

@@ -12,7 +12,10 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from robosoa import commands, logs
+from robosoa.cli_input import UsageError
 from robosoa.errors import RobosoaError
+from robosoa.location import Limits
+from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
 
 def _location(parser: argparse.ArgumentParser) -> None:
@@ -28,6 +31,26 @@ def _payload(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", metavar="PAYLOAD", help="payload as a JSON object")
 
 
+def _location_limits(p: argparse.ArgumentParser) -> None:
+    """What the location service accepts from peers (docs/security.md)."""
+    limits = Limits()
+    p.add_argument("--max-message", type=int, default=MAX_MESSAGE, metavar="BYTES",
+                   help=f"largest frame taken from a peer (default {MAX_MESSAGE})")
+    p.add_argument("--max-depth", type=int, default=MAX_DEPTH,
+                   help=f"deepest JSON nesting taken from a peer (default {MAX_DEPTH})")
+    p.add_argument("--max-ttl", type=float, default=limits.max_ttl, metavar="S",
+                   help=f"longer TTLs are cut to this (default {limits.max_ttl:g})")
+    p.add_argument("--max-entries", type=int, default=limits.max_entries,
+                   help=f"registrations in total (default {limits.max_entries})")
+    p.add_argument("--max-per-peer", type=int, default=limits.max_per_peer,
+                   help=f"registrations from one host (default {limits.max_per_peer})")
+    p.add_argument("--max-peers", type=int, default=limits.max_peers,
+                   help=f"federated location services (default {limits.max_peers})")
+    p.add_argument("--federation-timeout", type=float, default=limits.federation_timeout,
+                   metavar="S", help="seconds one lookup waits for all federated services "
+                   f"(default {limits.federation_timeout:g})")
+
+
 def _server_commands(sub: Any) -> None:
     p = sub.add_parser("location", help="run a location service and message broker")
     p.add_argument("--bind", default="tcp://127.0.0.1:5555", help="location endpoint")
@@ -38,6 +61,7 @@ def _server_commands(sub: Any) -> None:
                    help="broker queue per publisher and per subscriber (messages; then drops)")
     p.add_argument("--federate", action="append", metavar="ENDPOINT",
                    help="also answer for services of this location service (repeatable)")
+    _location_limits(p)
     p.set_defaults(run=commands.cmd_location)
 
     p = sub.add_parser("route", help="run a content-based router from a rules file")
@@ -130,7 +154,7 @@ def _guard(run: Callable[[], int]) -> int:
     """Run a command; user-facing failures become one line on stderr and an exit status."""
     try:
         return run()
-    except commands.UsageError as exc:
+    except UsageError as exc:
         print(f"robosoa: error: {exc}", file=sys.stderr)
         return 2
     except (RobosoaError, OSError, ValueError) as exc:

@@ -8,43 +8,18 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from importlib import import_module
 from typing import Any
 
 from robosoa import connect
 from robosoa.bus import Bus
+from robosoa.cli_input import UsageError, endpoint, location_config, parse_pairs, positive
 from robosoa.errors import RobosoaError
 from robosoa.location import ServiceInfo
 
 DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
 PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so the broker knows its subscribers
-
-
-class UsageError(Exception):
-    """Bad command-line input (exit status 2)."""
-
-
-def parse_pairs(pairs: Sequence[str], raw_json: str | None) -> dict[str, Any]:
-    """``key=value`` words (values parsed as JSON when they are JSON) merged over ``--json``."""
-    payload: dict[str, Any] = {}
-    if raw_json is not None:
-        try:
-            loaded = json.loads(raw_json)
-        except ValueError as exc:
-            raise UsageError(f"--json is not valid JSON: {exc}") from None
-        if not isinstance(loaded, dict):
-            raise UsageError("--json must be a JSON object")
-        payload.update(loaded)
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key:
-            raise UsageError(f"expected key=value, got {pair!r}")
-        try:
-            payload[key] = json.loads(value)
-        except ValueError:
-            payload[key] = value
-    return payload
 
 
 def location_url(text: str | None) -> str:
@@ -53,17 +28,29 @@ def location_url(text: str | None) -> str:
     return url if url.startswith(("zmq://", "inproc")) else f"zmq://{url}"
 
 
+def _checked_url(flag: str, text: str | None) -> str:
+    """``location_url(text)``, its endpoint checked (UsageError naming ``flag``)."""
+    url = location_url(text)
+    if url.startswith("zmq://"):
+        endpoint(flag, url.removeprefix("zmq://"))
+    return url
+
+
 def _bus(args: argparse.Namespace) -> Bus:
-    return connect(location_url(args.location), location_timeout=args.connect_timeout)
+    url = _checked_url("--location", args.location)
+    positive("--connect-timeout", args.connect_timeout)
+    return connect(url, location_timeout=args.connect_timeout)
 
 
 def cmd_location(args: argparse.Namespace) -> int:
     """Run a location service (and its message broker) until SIGINT/SIGTERM."""
-    from robosoa.transports.zmq_location import LocationConfig, LocationServer
+    from robosoa.transports.zmq_location import LocationServer
 
-    config = LocationConfig(args.bind, args.xsub or "", args.xpub or "", args.ttl,
-                            tuple(args.federate or ()), args.hwm)
-    server = LocationServer(config)
+    config = location_config(args)
+    try:
+        server = LocationServer(config)
+    except RobosoaError as exc:  # cannot bind or federate: the flags are wrong
+        raise UsageError(str(exc)) from None
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: server.stop())
     print(f"robosoa location service on {server.endpoint} "
@@ -149,6 +136,8 @@ def cmd_stats(args: argparse.Namespace) -> int:
     """Ask every provider instance for its counters and print them."""
     rows: list[dict[str, Any]] = []
     with _bus(args) as bus:
+        if args.name is None:  # the location service's own counters come first
+            rows += _location_rows(bus, args.timeout)
         for info in bus.services(args.name):
             try:
                 reply = bus.channel(info.name, info.instance).request("_stats", {},
@@ -156,8 +145,7 @@ def cmd_stats(args: argparse.Namespace) -> int:
             except RobosoaError as exc:
                 rows.append({"instance": info.instance, "error": str(exc)})
                 continue
-            for fig in reply.get("figures", []):
-                rows.append({"instance": info.instance, **fig})
+            rows += _figure_rows(info.instance, reply.get("figures"))
     if args.json:
         print(json.dumps(rows, indent=2))
         return 0
@@ -170,6 +158,32 @@ def cmd_stats(args: argparse.Namespace) -> int:
         print(f"{row['instance']:40} {row['role']:10} {row['key']:16} {row['count']:7d} "
               f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}")
     return 0
+
+
+def _location_rows(bus: Bus, timeout: float) -> list[dict[str, Any]]:
+    """Counters of the location service: requests answered, refused (``errors``)."""
+    try:
+        reply = bus.adapter.location({"op": "stats"}, timeout)
+    except RobosoaError as exc:
+        return [{"instance": "location", "error": str(exc)}]
+    if "error" in reply:
+        return [{"instance": "location", "error": str(reply["error"])[:200]}]
+    return _figure_rows(f"location {str(reply.get('location', ''))[:80]}", reply.get("figures"))
+
+
+_FIGURE_TYPES = {"key": (str,), "role": (str,), "count": (int,), "errors": (int,),
+                 "dropped": (int,), "p50_ms": (int, float), "p99_ms": (int, float)}
+
+
+def _figure_rows(instance: str, figures: object) -> list[dict[str, Any]]:
+    """Rows of the figures a peer sent; a malformed answer becomes one error row."""
+    rows: list[dict[str, Any]] = []
+    for fig in figures if isinstance(figures, list) else [None]:
+        if not (isinstance(fig, dict) and all(
+                type(fig.get(k)) in types for k, types in _FIGURE_TYPES.items())):
+            return [{"instance": instance, "error": "malformed statistics"}]
+        rows.append({"instance": instance, **{k: fig[k] for k in _FIGURE_TYPES}})
+    return rows
 
 
 def cmd_route(args: argparse.Namespace) -> int:
@@ -199,8 +213,9 @@ def cmd_bridge(args: argparse.Namespace) -> int:
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: stop.set())
-    with connect(location_url(args.source)) as source, \
-            connect(location_url(args.target)) as target, \
+    source_url = _checked_url("--source", args.source)
+    target_url = _checked_url("--target", args.target)
+    with connect(source_url) as source, connect(target_url) as target, \
             Bridge(source, target, args.service or (), args.topic or (), args.event or (),
                    both_ways=args.both_ways):
         print(f"bridge {args.source} -> {args.target} running", flush=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import logging
 import threading
 import time
 
@@ -11,6 +12,20 @@ from robosoa.location import ServiceInfo, select
 from robosoa.transports.base import BusOptions, ProtocolAdapter
 
 Selection = tuple[float, list[ServiceInfo]]
+log = logging.getLogger("robosoa.bus")
+
+
+def _entries(services: object) -> list[ServiceInfo]:
+    """The well-formed entries of a lookup reply (a location service is a peer like any)."""
+    if not isinstance(services, list):
+        raise RobosoaError("location service sent a malformed lookup reply")
+    infos = []
+    for data in services:
+        try:
+            infos.append(ServiceInfo.from_dict(data))
+        except ValueError as exc:
+            log.warning("malformed service entry skipped", extra={"reason": str(exc)})
+    return infos
 
 
 class Directory:
@@ -31,8 +46,8 @@ class Directory:
         reply = self._adapter.location({"op": "lookup", "name": name},
                                        limit if timeout is None else min(limit, timeout))
         if "error" in reply:
-            raise RobosoaError(f"location service: {reply['error']}")
-        infos = [ServiceInfo.from_dict(d) for d in reply.get("services", [])]
+            raise RobosoaError(f"location service: {str(reply['error'])[:500]}")
+        infos = _entries(reply.get("services"))
         if name is not None:
             with self._lock:
                 self._cache[name] = (time.monotonic(), infos)

@@ -11,6 +11,7 @@ from enum import StrEnum
 from typing import Any, NamedTuple
 
 from robosoa.errors import InvalidMessage
+from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_json
 
 Payload = dict[str, Any]
 
@@ -110,7 +111,6 @@ def to_dict(msg: Message) -> Payload:
 
 
 _ENCODE = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
-_DECODE = json.JSONDecoder().decode
 _FIELD_SET = frozenset(_FIELDS)
 _KINDS = {kind.value: kind for kind in Kind}
 _TEXT_FIELDS = ("service", "operation", "topic", "reply_to", "correlation_id", "id")
@@ -174,17 +174,18 @@ def from_dict(data: Any) -> Message:
                     and type(ident) is str)
             or not data.keys() <= _FIELD_SET):
         raise InvalidMessage(_why(data))
-    return Message(kind, service, operation, topic, payload, context, reply_to, correlation,
-                   error, ident, float(stamp))
-
-
-def decode(raw: bytes) -> Message:
-    """Parse wire bytes; raises InvalidMessage naming what is wrong."""
     try:
-        data = _DECODE(raw.decode())
-    except (UnicodeDecodeError, ValueError) as exc:
-        raise InvalidMessage(f"message is not valid JSON: {exc}") from None
-    return from_dict(data)
+        when = float(stamp)
+    except OverflowError:  # an integer of hundreds of digits
+        raise InvalidMessage("message timestamp is out of range") from None
+    return Message(kind, service, operation, topic, payload, context, reply_to, correlation,
+                   error, ident, when)
+
+
+def decode(raw: bytes, max_bytes: int = MAX_MESSAGE, max_depth: int = MAX_DEPTH) -> Message:
+    """Parse wire bytes from a peer within the size and depth limits (``robosoa.wire``);
+    raises InvalidMessage naming what is wrong."""
+    return from_dict(load_json(raw, max_bytes, max_depth))
 
 
 def check_payload(payload: Mapping[str, Any] | None) -> Payload:

@@ -14,6 +14,8 @@ from typing import Any, NamedTuple
 
 from robosoa.errors import RobosoaError
 from robosoa.message import Message
+from robosoa.stats import StatsBook
+from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
 Sink = Callable[[Message], None]  # must never block: it enqueues into a bounded queue
 ReplyFn = Callable[[Message], None]
@@ -36,6 +38,8 @@ class BusOptions:
     location_timeout: float = 2.0  # seconds to wait for the location service
     provider_bind: str = ""  # zmq: where providers bind, e.g. "tcp://0.0.0.0"; "" = derive
     advertise_host: str = ""  # zmq: host name/IP other machines use to reach our providers
+    max_message: int = MAX_MESSAGE  # bytes per frame taken from a peer (ZeroMQ MAXMSGSIZE)
+    max_depth: int = MAX_DEPTH  # JSON nesting taken from a peer (robosoa.wire)
 
 
 class Incoming(NamedTuple):
@@ -76,6 +80,15 @@ class ProtocolAdapter(ABC):
         self.address = address
         self.options = options
         self.connected = False
+        self.stats_book = StatsBook()  # the bus's counters; the transport adds role "wire"
+
+    def rejected(self, where: str) -> None:
+        """Count one frame from a peer that was refused (malformed, too large, too deep).
+
+        Shown by ``bus.stats()`` and ``robosoa stats`` as role ``wire``, key ``where``, in
+        ``errors``.
+        """
+        self.stats_book.counter(where, "wire").fail()
 
     # --- SOA_Base (Hestand 2011, p. 66) ---------------------------------------------
     @abstractmethod

@@ -93,14 +93,15 @@ class _InprocInbox(Inbox):
 
 
 class _ReplySlot:
-    __slots__ = ("event", "message")
+    __slots__ = ("event", "message", "options")
 
-    def __init__(self) -> None:
+    def __init__(self, options: BusOptions) -> None:
         self.event = threading.Event()
         self.message: Message | None = None
+        self.options = options
 
     def set(self, message: Message) -> None:
-        self.message = decode(encode(message))
+        self.message = decode(encode(message), self.options.max_message, self.options.max_depth)
         self.event.set()
 
 
@@ -164,14 +165,18 @@ class InprocAdapter(ProtocolAdapter):
 
     def call(self, endpoint: str, msg: Message, timeout: float) -> Message:
         inbox = self._inbox(endpoint)
-        slot = _ReplySlot()
-        inbox.put(Incoming(decode(encode(msg)), "", slot.set))
+        slot = _ReplySlot(self.options)
+        inbox.put(Incoming(self._copy(msg), "", slot.set))
         if not slot.event.wait(timeout) or slot.message is None:
             raise RequestTimeout(msg.service, msg.operation, timeout)
         return slot.message
 
     def post(self, endpoint: str, msg: Message) -> None:
-        self._inbox(endpoint).put(Incoming(decode(encode(msg)), "", None))
+        self._inbox(endpoint).put(Incoming(self._copy(msg), "", None))
+
+    def _copy(self, msg: Message) -> Message:
+        """The message as the receiver gets it: encoded and decoded within the same limits."""
+        return decode(encode(msg), self.options.max_message, self.options.max_depth)
 
     def open_inbox(self, instance: str) -> Inbox:
         broker = self._live()
@@ -186,7 +191,7 @@ class InprocAdapter(ProtocolAdapter):
         with broker.lock:
             sinks = list(broker.channels.get(channel, ()))
         if sinks:
-            delivered = decode(raw)
+            delivered = decode(raw, self.options.max_message, self.options.max_depth)
             for sink in sinks:
                 sink(delivered)
 

@@ -29,7 +29,8 @@ from robosoa.transports.base import (
 )
 from robosoa.transports.zmq_inbox import ZmqInbox
 from robosoa.transports.zmq_pubsub import Feed
-from robosoa.transports.zmq_sockets import public, split_endpoint
+from robosoa.transports.zmq_sockets import check_endpoint, limit_input, public
+from robosoa.wire import load_object
 
 SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
 SLICE_MS = int(SLICE * 1000) + 1
@@ -45,7 +46,7 @@ class ZmqAdapter(ProtocolAdapter):
     def __init__(self, address: str, options: BusOptions) -> None:
         super().__init__(address, options)
         self.endpoint = address.removeprefix("zmq://")
-        split_endpoint(self.endpoint)  # validates early, with a readable error
+        check_endpoint(self.endpoint)  # validates early, with a readable error
         self._ctx: zmq.Context[zmq.Socket[bytes]] | None = None
         self._local = threading.local()
         self._sockets: set[zmq.Socket[bytes]] = set()
@@ -74,7 +75,7 @@ class ZmqAdapter(ProtocolAdapter):
             raise RobosoaError(f"location service at {self.endpoint} has no message broker")
         if self._feed is None:
             assert self._ctx is not None
-            self._feed = Feed(self._ctx, broker, self.options.hwm)
+            self._feed = Feed(self._ctx, broker, self.options, self.rejected)
         elif broker != self._broker:
             self._feed.move(broker)
         self._broker = broker
@@ -125,6 +126,7 @@ class ZmqAdapter(ProtocolAdapter):
         sock.setsockopt(zmq.SNDHWM, self.options.hwm)
         sock.setsockopt(zmq.RCVHWM, self.options.hwm)
         sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
+        limit_input(sock, self.options.max_message)
         sock.connect(endpoint)
         cache[endpoint] = sock
         with self._lock:
@@ -201,10 +203,11 @@ class ZmqAdapter(ProtocolAdapter):
 
         def accept(data: bytes) -> dict[str, Any] | None:
             try:
-                reply = json.loads(data)
-            except ValueError:
+                reply = load_object(data, self.options.max_message, self.options.max_depth)
+            except InvalidMessage:
+                self.rejected("location")
                 return None
-            return reply if isinstance(reply, dict) and reply.get("rid") == rid else None
+            return reply if reply.get("rid") == rid else None
 
         reply: dict[str, Any] | None = self._receive(sock, deadline, accept)
         if reply is None:
@@ -226,8 +229,9 @@ class ZmqAdapter(ProtocolAdapter):
 
         def accept(data: bytes) -> Message | None:
             try:
-                reply = decode(data)
+                reply = decode(data, self.options.max_message, self.options.max_depth)
             except InvalidMessage:
+                self.rejected("reply")
                 return None
             return reply if reply.correlation_id in (msg.id, "") else None
 
@@ -263,7 +267,7 @@ class ZmqAdapter(ProtocolAdapter):
     def open_inbox(self, instance: str) -> Inbox:
         if self._ctx is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return ZmqInbox(self._ctx, self.endpoint, self.options)
+        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected)
 
     def _live_feed(self) -> Feed:
         if self._feed is None or not self.connected:

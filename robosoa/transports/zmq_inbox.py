@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import uuid
+from collections.abc import Callable
 
 import zmq
 
 from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode, encode
 from robosoa.transports.base import BusOptions, Inbox, Incoming
-from robosoa.transports.zmq_sockets import bind_provider
+from robosoa.transports.zmq_sockets import bind_provider, limit_input
 
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
 _MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
@@ -24,12 +25,15 @@ class ZmqInbox(Inbox):
     """
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
-                 options: BusOptions) -> None:
+                 options: BusOptions, rejected: Callable[[str], None]) -> None:
         self._ctx = ctx
+        self._options = options
+        self._rejected = rejected
         self._router = ctx.socket(zmq.ROUTER)
         self._router.setsockopt(zmq.LINGER, 0)
         self._router.setsockopt(zmq.RCVHWM, options.inbox_size)
         self._router.setsockopt(zmq.SNDHWM, options.hwm)
+        limit_input(self._router, options.max_message)
         self.endpoint = bind_provider(self._router, location,
                                       options.provider_bind,
                                       options.advertise_host)
@@ -59,12 +63,14 @@ class ZmqInbox(Inbox):
             router.send(raw, _NOBLOCK)
 
         if extra:
+            self._rejected("inbox")
             return Incoming(None, f"expected one message frame, got {extra + 1}", reply)
         if data == self._token:
             return None
         try:
-            msg = decode(data)
-        except InvalidMessage as exc:
+            msg = decode(data, self._options.max_message, self._options.max_depth)
+        except InvalidMessage as exc:  # answered with an error reply by the provider
+            self._rejected("inbox")
             return Incoming(None, str(exc), reply)
         return Incoming(msg, "", None if msg.kind is Kind.ONEWAY else reply)
 

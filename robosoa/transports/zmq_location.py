@@ -6,16 +6,24 @@ thread); the location protocol is answered by ``robosoa.location.LocationService
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import zmq
 
-from robosoa.location import LocationService, Peer, Registry, ServiceInfo
-from robosoa.transports.zmq_sockets import location_request, split_endpoint
+from robosoa.errors import InvalidMessage, RobosoaError
+from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
+from robosoa.transports.zmq_sockets import (
+    check_endpoint,
+    limit_input,
+    location_request,
+    split_endpoint,
+)
+from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_object
 
 log = logging.getLogger("robosoa.location")
 
@@ -24,7 +32,8 @@ PEER_TIMEOUT = 0.3  # seconds a federated lookup may take before the peer is ski
 
 @dataclass(frozen=True, slots=True)
 class LocationConfig:
-    """Where the location service listens, its default TTL and its federation peers."""
+    """Where the location service listens, its default TTL, its federation peers and what it
+    accepts from peers (every limit is documented in docs/security.md)."""
 
     bind: str
     xsub: str = ""  # broker input (publishers connect); default: port + 1 or PATH.xsub
@@ -32,6 +41,9 @@ class LocationConfig:
     ttl: float = 3.0
     federate: tuple[str, ...] = ()
     hwm: int = 1000  # broker queue per publisher (XSUB) and per subscriber (XPUB); then drops
+    max_message: int = MAX_MESSAGE  # bytes per frame from a peer, broker frames included
+    max_depth: int = MAX_DEPTH  # JSON nesting of one location request
+    limits: Limits = field(default_factory=Limits)  # registrations, TTLs, federation
 
 
 def _wild(endpoint: str) -> str:
@@ -51,21 +63,37 @@ def broker_binds(config: LocationConfig) -> tuple[str, str]:
     return _wild(config.xsub or derived[0]), _wild(config.xpub or derived[1])
 
 
+def _peer_of(frame: zmq.Frame) -> str:
+    """Who sent ``frame``: the remote host for tcp, the process for ipc (registry ownership)."""
+    try:
+        return str(frame.get("Peer-Address"))
+    except zmq.ZMQError:
+        return ""
+
+
 class LocationServer:
     """Binds the sockets at construction; ``serve`` answers until ``stop`` is called."""
 
     def __init__(self, config: LocationConfig) -> None:
         self.config = config
         self._ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
-        self._router = self._socket(zmq.ROUTER, _wild(config.bind))
-        xsub_bind, xpub_bind = broker_binds(config)
-        self._xsub = self._socket(zmq.XSUB, xsub_bind, config.hwm)
-        self._xpub = self._socket(zmq.XPUB, xpub_bind, config.hwm)
+        self._sockets: list[zmq.Socket[bytes]] = []
+        try:  # a bind that fails (bad address, port taken) releases what was bound before
+            self._router = self._socket(zmq.ROUTER, _wild(config.bind))
+            xsub_bind, xpub_bind = broker_binds(config)
+            self._xsub = self._socket(zmq.XSUB, xsub_bind, config.hwm)
+            self._xpub = self._socket(zmq.XPUB, xpub_bind, config.hwm)
+        except BaseException:
+            for sock in self._sockets:
+                sock.close(0)
+            self._ctx.term()
+            raise
         self.endpoint = self._last(self._router)
         self.broker = (self._last(self._xsub), self._last(self._xpub))
         hello = {"transport": "zmq", "xsub": self.broker[0], "xpub": self.broker[1]}
-        self.service = LocationService(Registry(default_ttl=config.ttl), self._peer, hello,
-                                       name=self.endpoint)
+        registry = Registry(default_ttl=config.ttl, limits=config.limits)
+        self.service = LocationService(registry, self._peer, hello, name=self.endpoint,
+                                       limits=config.limits)
         for address in config.federate:
             self.service.federate(address)
         self._control = f"inproc://robosoa-proxy-{id(self)}"
@@ -73,11 +101,17 @@ class LocationServer:
         self._proxy = threading.Thread(target=self._run_proxy, daemon=True, name="robosoa-broker")
 
     def _socket(self, kind: int, bind: str, hwm: int = 1000) -> zmq.Socket[bytes]:
+        check_endpoint(bind)
         sock = self._ctx.socket(kind)
+        self._sockets.append(sock)
         sock.setsockopt(zmq.LINGER, 0)
         sock.setsockopt(zmq.SNDHWM, hwm)
         sock.setsockopt(zmq.RCVHWM, hwm)
-        sock.bind(bind)
+        limit_input(sock, self.config.max_message)
+        try:
+            sock.bind(bind)
+        except zmq.ZMQError as exc:
+            raise RobosoaError(f"cannot bind {bind}: {exc.strerror}") from None
         return sock
 
     @staticmethod
@@ -86,11 +120,17 @@ class LocationServer:
 
     def _peer(self, address: str) -> Peer:
         ctx = self._ctx
+        check_endpoint(address)
+        request = {"op": "lookup", "local": True}
+        timeout = min(PEER_TIMEOUT, self.config.limits.federation_timeout)
 
         def lookup(name: str | None) -> list[ServiceInfo]:
-            reply = location_request(ctx, address, {"op": "lookup", "name": name, "local": True},
-                                     PEER_TIMEOUT)
-            return [ServiceInfo.from_dict(d) for d in reply.get("services", [])]
+            reply = location_request(ctx, address, {**request, "name": name}, timeout,
+                                     self.config.max_message)
+            services = reply.get("services", [])
+            if not isinstance(services, list):
+                raise RobosoaError(f"location service at {address} sent a bad reply")
+            return [ServiceInfo.from_dict(d) for d in services]
 
         return lookup
 
@@ -104,19 +144,30 @@ class LocationServer:
         finally:
             control.close(0)
 
-    def _answer(self, frames: list[bytes]) -> None:
-        if len(frames) != 2:
-            return
+    def _answer(self, frames: list[zmq.Frame]) -> None:
+        """Answer one request; a malformed one gets an error reply and is counted."""
         try:
-            request: Any = json.loads(frames[1])
-        except ValueError:
-            request = None
-        if isinstance(request, dict):
-            reply = self.service.handle(request)
-            reply["rid"] = request.get("rid")
+            request = self._request(frames)
+        except InvalidMessage as exc:
+            self.service.counter.record(None, error=True)
+            reply: dict[str, Any] = {"error": f"bad location request: {exc}"}
         else:
-            reply = {"error": "location request is not a JSON object"}
-        self._router.send_multipart([frames[0], json.dumps(reply).encode()], zmq.NOBLOCK)
+            reply = self.service.handle(request, _peer_of(frames[-1]))
+            reply["rid"] = request.get("rid")
+        with contextlib.suppress(zmq.ZMQError):  # the peer is gone or its queue is full
+            self._router.send_multipart([frames[0].bytes, json.dumps(reply).encode()],
+                                        zmq.NOBLOCK)
+
+    def _request(self, frames: list[zmq.Frame]) -> dict[str, Any]:
+        if len(frames) != 2:
+            raise InvalidMessage(f"expected one message frame, got {len(frames) - 1}")
+        config = self.config
+        request = load_object(frames[1].bytes, config.max_message, config.max_depth)
+        if type(request.get("op")) is not str:
+            raise InvalidMessage("op is not a string")
+        if type(request.get("rid")) not in (int, str, type(None)):
+            raise InvalidMessage("rid is not a number or a string")
+        return request
 
     def serve(self) -> None:
         """Answer location requests and forward broker traffic until ``stop``."""
@@ -129,7 +180,12 @@ class LocationServer:
         try:
             while not self._stop.is_set():
                 if self._router.poll(200, zmq.POLLIN):
-                    self._answer(self._router.recv_multipart())
+                    frames = self._router.recv_multipart(copy=False)
+                    try:
+                        self._answer(frames)
+                    except Exception:  # last line of defence: no request ends the service
+                        self.service.counter.fail()
+                        log.exception("location request failed")
                 self.service.registry.expire()
         finally:
             steer.send(b"TERMINATE")

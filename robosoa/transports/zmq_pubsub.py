@@ -17,8 +17,8 @@ import zmq
 
 from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode, encode
-from robosoa.transports.base import Sink
-from robosoa.transports.zmq_sockets import Waker
+from robosoa.transports.base import BusOptions, Sink
+from robosoa.transports.zmq_sockets import Waker, limit_input
 
 log = logging.getLogger("robosoa.zmq")
 
@@ -54,13 +54,14 @@ class Feed:
     """The publish and subscribe side of one bus."""
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], broker: tuple[str, str],
-                 hwm: int) -> None:
+                 options: BusOptions, rejected: Callable[[str], None]) -> None:
         self._ctx = ctx
         self._broker = broker
-        self._hwm = hwm
+        self._options = options
+        self._rejected = rejected  # counts malformed broadcasts (dropped: nobody to answer)
         self._pub = ctx.socket(zmq.PUB)
         self._pub.setsockopt(zmq.LINGER, 0)
-        self._pub.setsockopt(zmq.SNDHWM, hwm)
+        self._pub.setsockopt(zmq.SNDHWM, options.hwm)
         self._pub.connect(broker[0])
         self._pub_lock = threading.Lock()
         self._sinks: dict[str, tuple[Sink, ...]] = {}  # replaced, never mutated: lock-free reads
@@ -146,11 +147,13 @@ class Feed:
 
     def _deliver(self, frames: list[bytes]) -> None:
         if len(frames) != 2:
+            self._rejected("broadcast")
             return
         try:
-            msg = decode(frames[1])
+            msg = decode(frames[1], self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:
-            log.warning("malformed broadcast dropped", extra={"reason": str(exc)})
+            self._rejected("broadcast")
+            log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
             return
         token = msg.context.get(PROBE)
         if token is not None:
@@ -164,7 +167,8 @@ class Feed:
     def _run(self) -> None:
         sub = self._ctx.socket(zmq.SUB)
         sub.setsockopt(zmq.LINGER, 0)
-        sub.setsockopt(zmq.RCVHWM, self._hwm)
+        sub.setsockopt(zmq.RCVHWM, self._options.hwm)
+        limit_input(sub, self._options.max_message)
         endpoint = self._broker[1]
         sub.connect(endpoint)
         poller = zmq.Poller()

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import contextlib
+import ipaddress
 import json
 import os
+import re
 import socket
 import tempfile
 import threading
@@ -13,11 +15,12 @@ from typing import Any
 
 import zmq
 
-from robosoa.errors import RobosoaError
+from robosoa.errors import InvalidMessage, RobosoaError
+from robosoa.wire import MAX_MESSAGE, load_object
 
 
 def split_endpoint(endpoint: str) -> tuple[str, str, int]:
-    """``tcp://h:p`` -> ("tcp", h, p); ``ipc:///x`` -> ("ipc", "/x", 0)."""
+    """``tcp://h:p`` -> ("tcp", h, p); ``ipc:///x`` -> ("ipc", "/x", 0); ``*`` port -> 0."""
     scheme, _, rest = endpoint.partition("://")
     if scheme == "ipc":
         return scheme, rest, 0
@@ -25,7 +28,42 @@ def split_endpoint(endpoint: str) -> tuple[str, str, int]:
         raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: expected tcp://HOST:PORT or "
                            "ipc:///PATH")
     host, _, port = rest.rpartition(":")
-    return scheme, host.strip("[]"), int(port) if port.isdigit() else 0
+    if port.isascii() and port.isdigit() and int(port) <= 65535:
+        return scheme, host.strip("[]"), int(port)
+    if port == "*":
+        return scheme, host.strip("[]"), 0
+    raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: port {port!r} is not 0-65535 or *")
+
+
+_HOST_NAME = re.compile(r"[A-Za-z0-9]([A-Za-z0-9.-]{0,252}[A-Za-z0-9])?")
+
+
+def check_endpoint(endpoint: str) -> str:
+    """``endpoint`` if it can be bound or connected to; else RobosoaError saying why.
+
+    tcp: the host is ``*``, an IP address or a host/interface name, the port 0-65535 or ``*``;
+    ipc: the folder of the path exists.
+    """
+    scheme, host, _ = split_endpoint(endpoint)
+    if scheme == "ipc":
+        folder = os.path.dirname(host)
+        if not host or (not host.startswith("@") and folder and not os.path.isdir(folder)):
+            raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: folder {folder!r} does "
+                               "not exist")
+        return endpoint
+    if host == "*" or (_HOST_NAME.fullmatch(host) and not host.replace(".", "").isdigit()):
+        return endpoint
+    try:
+        ipaddress.ip_address(host)
+    except ValueError:
+        raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: {host!r} is not an IP address "
+                           "or host name") from None
+    return endpoint
+
+
+def limit_input(sock: zmq.Socket[bytes], max_message: int) -> None:
+    """Refuse frames larger than ``max_message`` bytes from peers (ZeroMQ drops the peer)."""
+    sock.setsockopt(zmq.MAXMSGSIZE, max_message)
 
 
 def local_ip_towards(host: str) -> str:
@@ -68,19 +106,21 @@ def public(endpoint: str, location: str) -> str:
 
 
 def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
-                     request: dict[str, Any], timeout: float) -> dict[str, Any]:
+                     request: dict[str, Any], timeout: float,
+                     max_message: int = MAX_MESSAGE) -> dict[str, Any]:
     """One-shot location-protocol request on a fresh socket (used for federation peers)."""
     sock = ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
+    limit_input(sock, max_message)
     try:
         sock.connect(endpoint)
         sock.send(json.dumps(request).encode())
         if not sock.poll(int(timeout * 1000), zmq.POLLIN):
             raise RobosoaError(f"location service at {endpoint} did not answer")
-        reply = json.loads(sock.recv())
-        if not isinstance(reply, dict):
-            raise RobosoaError(f"location service at {endpoint} sent a bad reply")
-        return reply
+        try:
+            return load_object(sock.recv(), max_message)
+        except InvalidMessage as exc:
+            raise RobosoaError(f"location service at {endpoint} sent a bad reply: {exc}") from None
     finally:
         sock.close()
 
