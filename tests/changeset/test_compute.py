@@ -215,9 +215,9 @@ def test_report_json_shape() -> None:
 
 
 def test_greedy_pairing_is_flagged_in_the_summary(monkeypatch: pytest.MonkeyPatch) -> None:
-    from archmetrics.changeset import statement_diff
+    from archmetrics.changeset import pairing
 
-    monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 1)
+    monkeypatch.setattr(pairing, "EXACT_PAIRING_CELLS", 1)
     report = run(
         FilePair(
             facts("client/a.py", "a = 1", "b = 1"),

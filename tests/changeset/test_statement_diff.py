@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from archmetrics.changeset import statement_diff
+from archmetrics.changeset import pairing, statement_diff
 from archmetrics.changeset.statement_diff import Action, diff_statements, similarity
 from archmetrics.facts import Deferred, Span, Statement
 from archmetrics.sources import codec
@@ -70,8 +70,18 @@ def test_moved_statement_is_removed_and_added_and_flagged() -> None:
 
 
 def test_similarity_is_over_tokens() -> None:
-    assert similarity("count = 0", "n = 0") == 2 * 2 / 6
+    assert similarity("count = 0", "n = 0") == pytest.approx(2 * 2 / 6)
     assert similarity("", "") == 1.0
+
+
+def test_similarity_is_the_lcs_ratio_not_difflibs() -> None:
+    """2·LCS/T: the tokens of 'a = b ( c )' and 'c ( a , b )' have a longest common
+    subsequence of 3 ('a b )'), so 6/12; difflib's Ratcliff-Obershelp ratio, used before,
+    takes the first longest block ('a' with 'a') and finds only 2 (4/12), so they did not pair.
+    """
+    assert similarity("a = b ( c )", "c ( a , b )") == pytest.approx(0.5)
+    pre, post = stmts(("assign", "a = b ( c )")), stmts(("call", "c ( a , b )"))
+    assert counts(pre, post) == (0, 0, 1)
 
 
 def test_huge_replace_runs_pair_greedily_and_say_so(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -79,7 +89,7 @@ def test_huge_replace_runs_pair_greedily_and_say_so(monkeypatch: pytest.MonkeyPa
     post = stmts(*[("call", f"new_{i}(a)") for i in range(31)])
     exact = diff_statements(pre, post)
     assert not exact.approximate and (exact.modified, exact.added) == (30, 1)
-    monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 100)
+    monkeypatch.setattr(pairing, "EXACT_PAIRING_CELLS", 100)
     rough = diff_statements(pre, post)
     assert rough.approximate and (rough.modified, rough.added) == (30, 1)
 
@@ -89,7 +99,7 @@ def test_a_square_run_of_matching_kinds_pairs_in_place_at_any_size(
 ) -> None:
     pre = stmts(*[("call" if i % 3 else "if", f"old_{i}(a)") for i in range(30)])
     post = stmts(*[("call" if i % 3 else "if", f"new({i})") for i in range(30)])
-    monkeypatch.setattr(statement_diff, "EXACT_PAIRING_LIMIT", 100)
+    monkeypatch.setattr(pairing, "EXACT_PAIRING_CELLS", 100)
     change = diff_statements(pre, post)
     assert not change.approximate and change.modified == 30
     assert [(c.pre, c.post) for c in change.changes] == list(zip(pre, post, strict=True))
@@ -111,9 +121,9 @@ def test_the_in_place_pairing_is_what_the_exact_rule_chooses(
     texts = data.draw(st.lists(_PAIR_TEXTS, min_size=size, max_size=size))
     removed = stmts(*pre_items)
     added = stmts(*[(kind, text) for (kind, _), text in zip(pre_items, texts, strict=True)])
-    forced = statement_diff._forced(removed, added)
+    forced = pairing.forced(removed, added)
     assert forced is not None
-    assert [(i, j) for i, j, _ in statement_diff._pair_exact(removed, added)] == [
+    assert [(i, j) for i, j, _ in pairing.pair_exact(removed, added)] == [
         (i, j) for i, j, _ in forced
     ]
 
@@ -161,3 +171,43 @@ def test_cached_files_that_changed_only_in_layout_are_not_decoded() -> None:
     assert (change.added, change.removed, change.modified) == (0, 0, 0)
     assert (pre.statements._items, post.statements._items) == (None, None)
     assert statement_diff.diff_files(pre, other).modified == 1  # decoded when they differ
+
+
+def _reference_pairs(
+    removed: tuple[Statement, ...], added: tuple[Statement, ...]
+) -> list[tuple[int, int]]:
+    """The rule, written the plain way: a table of (pairs, summed similarity in quanta)."""
+    m, n = len(removed), len(added)
+    best = [[(0, 0)] * (n + 1) for _ in range(m + 1)]
+    for i in range(1, m + 1):
+        for j in range(1, n + 1):
+            value = max(best[i - 1][j], best[i][j - 1])
+            ratio = similarity(removed[i - 1].text, added[j - 1].text)
+            if pairing.may_pair(removed[i - 1], added[j - 1], ratio):
+                count, score = best[i - 1][j - 1]
+                value = max(value, (count + 1, score + round(ratio * pairing.SCORE_QUANTUM)))
+            best[i][j] = value
+    pairs, i, j = [], m, n
+    while i > 0 and j > 0:
+        if best[i][j] == best[i - 1][j]:
+            i -= 1
+        elif best[i][j] == best[i][j - 1]:
+            j -= 1
+        else:
+            pairs.append((i - 1, j - 1))
+            i, j = i - 1, j - 1
+    return pairs[::-1]
+
+
+_RUN = st.lists(st.tuples(_KINDS, st.text("ab(=) ,", max_size=10)), max_size=12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(_RUN, _RUN)
+def test_the_table_in_numpy_is_the_rule(
+    removed_items: list[tuple[str, str]], added_items: list[tuple[str, str]]
+) -> None:
+    removed, added = stmts(*removed_items), stmts(*added_items)
+    assert [(i, j) for i, j, _ in pairing.pair_exact(removed, added)] == _reference_pairs(
+        removed, added
+    )
