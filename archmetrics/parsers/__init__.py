@@ -7,6 +7,7 @@ type-checked when loaded.
 
 from __future__ import annotations
 
+from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits
 from archmetrics.parsers.registry import (
     DEFAULT_EXTENSIONS,
     LanguageSpec,
@@ -17,8 +18,10 @@ from archmetrics.parsers.registry import (
 
 __all__ = [
     "DEFAULT_EXTENSIONS",
+    "DEFAULT_LIMITS",
     "LanguageSpec",
     "LanguageTable",
+    "ParseLimits",
     "UnknownLanguage",
     "parse_source",
 ]

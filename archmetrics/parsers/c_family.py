@@ -8,13 +8,10 @@ tokens in between. Statement rules follow thesis page 103; decisions follow liza
 from __future__ import annotations
 
 import bisect
-import importlib
 import re
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from tree_sitter import Language as TSLanguage
-from tree_sitter import Node, Parser, Query, QueryCursor, QueryError
+from tree_sitter import Node, QueryCursor
 
 from archmetrics.facts import (
     Decision,
@@ -26,24 +23,27 @@ from archmetrics.facts import (
     Span,
 )
 from archmetrics.parsers import c_tables
+from archmetrics.parsers.c_family_calls import CallSites
+from archmetrics.parsers.c_family_grammar import (
+    QUERY_DEPTH,
+    Grammar,
+    deeper_than,
+    grammar,
+    syntax_tree,
+)
 from archmetrics.parsers.c_family_names import (
-    call_site,
+    Scopes,
     function_name,
     in_order,
     span,
+    typedef_names,
 )
 from archmetrics.parsers.c_family_outline import classes, includes, warnings
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
 from archmetrics.parsers.c_family_text import blank_comments, sloc
+from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, not_measured
 
-
-@dataclass(frozen=True, slots=True)
-class Grammar:
-    """A language's parser and queries, built once per process."""
-
-    parser: Parser
-    query: Query
-    rules: Mapping[str, c_tables.StatementRule]
+__all__ = ["Grammar", "grammar", "hide_extern_c_guards", "parse"]
 
 
 @dataclass(slots=True)
@@ -61,61 +61,12 @@ class FunctionSlot:
     statements: int = 0
 
 
-_GRAMMARS: dict[str, Grammar] = {}
-
-
-def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule]) -> list[str]:
-    def known(kind: str, named: bool = True) -> bool:
-        return language.id_for_node_kind(kind, named) is not None
-
-    plain = [kind for kind in rules if kind not in c_tables.SPECIFIERS and known(kind)]
-    specifiers = " ".join(f"({kind})" for kind in c_tables.SPECIFIERS if known(kind))
-    tokens = " ".join(f'"{token}"' for token in c_tables.DECISIONS if known(token, False))
-    classes = " ".join(f"({kind} body: (_))" for kind in c_tables.CLASSES if known(kind))
-    return [
-        "[" + " ".join(f"({kind})" for kind in plain) + "] @stmt",
-        f"[{specifiers}] @specifier",  # kept only where they stand alone (see _standalone)
-        *c_tables.NOT_STATEMENTS,
-        f"[{tokens}] @decision",
-        *c_tables.NOT_DECISIONS,
-        *c_tables.DIRECTIVE_CONDITIONS,
-        f"[{classes}] @class",
-        "(call_expression) @call",
-        "(comment) @comment",
-        "(ERROR) @error",
-        "(MISSING) @missing",
-        f"({c_tables.TEMPLATE}) @template",
-        "[" + " ".join(f"({kind})" for kind in c_tables.BODIES) + "] @body",
-    ]
-
-
-def _compiles(language: TSLanguage, pattern: str) -> bool:
-    try:
-        Query(language, pattern)
-    except QueryError:
-        return False  # a node type this grammar does not have (C has no templates)
-    return True
-
-
-def grammar(language: str) -> Grammar:
-    """The parser and queries for ``language`` (C or C++), built on first use."""
-    built = _GRAMMARS.get(language)
-    if built is not None:
-        return built
-    is_c = language == Language.C
-    module = importlib.import_module("tree_sitter_c" if is_c else "tree_sitter_cpp")
-    ts_language = TSLanguage(module.language())
-    rules = c_tables.C_STATEMENTS if is_c else c_tables.CPP_STATEMENTS
-    patterns = [p for p in _patterns(ts_language, rules) if _compiles(ts_language, p)]
-    built = Grammar(Parser(ts_language), Query(ts_language, "\n".join(patterns)), rules)
-    _GRAMMARS[language] = built
-    return built
-
-
-def parse(path: str, source: str, language: Language) -> FileFacts:
+def parse(
+    path: str, source: str, language: Language, limits: ParseLimits = DEFAULT_LIMITS
+) -> FileFacts:
     """Facts for one C or C++ file. Never raises: what cannot be read becomes a warning."""
     try:
-        return _parse(path, source, language)
+        return _parse(path, source, language, limits)
     except Exception as error:  # a bug here must not stop a whole repository's measurement
         message = f"C/C++ parser failed ({type(error).__name__}: {error}); file not measured"
         return FileFacts(
@@ -143,20 +94,36 @@ def hide_extern_c_guards(data: bytes) -> bytes:
     return _EXTERN_C_GUARD.sub(lambda m: m.group(1) + b" " * len(m.group(2)), data)
 
 
-def _parse(path: str, source: str, language: Language) -> FileFacts:
+def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
-    root = built.parser.parse(data).root_node
+    tree = syntax_tree(built.parser, data, limits.parse_seconds)
+    if tree is None:
+        message = (
+            f"tree-sitter's parse took longer than {limits.parse_seconds:g} s and was cut off"
+            " (raise ParseLimits.parse_seconds to measure it)"
+        )
+        return not_measured(path, str(language), 1, message)
+    root = tree.root_node
+    depth = min(limits.max_depth, QUERY_DEPTH)
+    if deeper_than(root, depth):
+        message = f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
+            "the limit is ParseLimits.max_depth (raise it to measure the file)"
+            if depth == limits.max_depth
+            else "tree-sitter's query cannot go deeper"
+        )
+        return not_measured(path, str(language), 1, message)
     found = QueryCursor(built.query).captures(root)
-    slots = _functions(found.get("stmt", []), data)
+    typedefs = typedef_names(found.get("stmt", []), data)
+    scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
+    slots = _functions(found.get("stmt", []), data, scopes)
     owner = _Owners(slots)
     skip = {node.id for node in found.get("skip", [])}
     guard = include_guard(root, data)
     if guard is not None:
         skip.add(guard)
-    nodes = in_order(
-        node for node in found.get("stmt", []) + _standalone(found) if node.id not in skip
-    )
+    standalone = _standalone(root, found.get("specifier", []))
+    nodes = in_order(node for node in found.get("stmt", []) + standalone if node.id not in skip)
     comments = sorted((n.start_byte, n.end_byte) for n in found.get("comment", []))
     clean = blank_comments(data, comments)
     facts_statements = statements(
@@ -170,24 +137,45 @@ def _parse(path: str, source: str, language: Language) -> FileFacts:
         functions=tuple(
             Function(s.name, s.qualified, s.span, tuple(s.decisions), s.statements) for s in slots
         ),
-        classes=classes(found.get("class", []), data),
+        classes=classes(found.get("class", []), scopes),
         dependencies=includes(nodes, data),
-        call_sites=tuple(
-            call_site(node, data, owner.name(node.start_byte))
-            for node in in_order(found.get("call", []))
-        ),
+        call_sites=CallSites(found.get("call", []), data).sites(owner.name),
         sloc=sloc(clean),
         warnings=warnings(path, found, data),
     )
 
 
-def _standalone(found: dict[str, list[Node]]) -> list[Node]:
-    """Type specifiers that are a statement of their own (not inside a declaration)."""
+def _standalone(root: Node, specifiers: list[Node]) -> list[Node]:
+    """Type specifiers that are a statement of their own: those whose parent is a container
+    (a file, a block, a class or namespace body), not a declaration.
+
+    The parents are found by one cursor moving through the tree from one specifier to the
+    next (up, forward, down), not by ``node.parent``: tree-sitter finds a parent by
+    descending from the root again, which costs n² steps for n nested specifiers."""
     containers = c_tables.SPECIFIER_CONTAINERS
     standalone: list[Node] = []
-    for node in found.get("specifier", []):
-        parent = node.parent
-        if parent is not None and parent.type in containers:
+    cursor = root.walk()
+    above: list[str] = []  # the types of the nodes above the cursor's, innermost last
+    for node in in_order(specifiers):
+        start, end = node.start_byte, node.end_byte
+        at: Node | None = cursor.node
+        while at is not None and not (at.start_byte <= start and end <= at.end_byte):
+            if at.end_byte <= start and cursor.goto_next_sibling():
+                at = cursor.node  # forward among siblings: a wide node is crossed once
+            elif cursor.goto_parent():
+                at = cursor.node
+                above.pop()
+            else:
+                break
+        while at is not None and at.id != node.id:
+            kind = at.type
+            if cursor.goto_first_child_for_byte(start) is None:
+                break
+            above.append(kind)
+            at = cursor.node
+            while at is not None and at.end_byte < end and cursor.goto_next_sibling():
+                at = cursor.node  # a child that ends too soon (empty, or a missing token)
+        if at is not None and at.id == node.id and above and above[-1] in containers:
             standalone.append(node)
     return standalone
 
@@ -219,16 +207,17 @@ class _Owners:
         return slot.qualified if slot is not None else None
 
 
-def _functions(nodes: list[Node], data: bytes) -> list[FunctionSlot]:
+def _functions(nodes: list[Node], data: bytes, scopes: Scopes) -> list[FunctionSlot]:
     """Function definitions with a body that are not inside another function (as lizard)."""
     slots: list[FunctionSlot] = []
     last_end = -1
     definitions = in_order(node for node in nodes if node.type == c_tables.FUNCTION)
+    prefixes = scopes.prefixes(definitions)
     for node in definitions:
         body = node.child_by_field_name("body")
         if body is None or node.start_byte < last_end:
             continue
-        name, qualified = function_name(node, data)
+        name, qualified = function_name(node, data, prefixes[node.id])
         slots.append(
             FunctionSlot(
                 name,

@@ -6,20 +6,23 @@ from tree_sitter import Node
 
 from archmetrics.facts import Class, Dependency, DependencyKind, ParseWarning
 from archmetrics.parsers import c_tables
-from archmetrics.parsers.c_family_names import class_name, in_order, scopes, span, text
+from archmetrics.parsers.c_family_names import Scopes, in_order, span, text
 from archmetrics.parsers.c_family_text import string_value
 
 _MAX_WARNINGS = 20
 
 
-def classes(nodes: list[Node], data: bytes) -> tuple[Class, ...]:
+def classes(nodes: list[Node], scopes: Scopes) -> tuple[Class, ...]:
     """Structs, classes and unions with a body; anonymous ones only under a typedef name."""
     classes: list[Class] = []
-    for node in in_order(nodes):
-        name = class_name(node, data)
+    ordered = in_order(nodes)
+    prefixes = scopes.prefixes(ordered)
+    for node in ordered:
+        name = scopes.class_names[node.id]
         if name is None:
             continue
-        qualified = "::".join([*scopes(node, data), name])
+        prefix = prefixes[node.id]
+        qualified = f"{prefix}::{name}" if prefix else name
         classes.append(Class(name, qualified, span(node), c_tables.CLASSES[node.type]))
     return tuple(classes)
 
@@ -59,9 +62,9 @@ def warnings(path: str, found: dict[str, list[Node]], data: bytes) -> tuple[Pars
                 f"could not parse {snippet!r} (a macro?); lines here may be under-counted",
             )
         )
+    expected = {node.id for node in found.get("expected", [])}
     for node in found.get("missing", []):
-        parent = node.parent
-        if parent is not None and parent.type == "template_instantiation":
+        if node.id in expected:
             continue  # tree-sitter-cpp wants a declarator in `template class Box<int>;`
         problems.append((node.start_point.row + 1, f"missing {node.type!r} assumed by the parser"))
     problems.sort()

@@ -14,7 +14,7 @@ from tree_sitter import Node, Point
 
 from archmetrics.facts import Span, Statement
 from archmetrics.parsers.c_family_names import text
-from archmetrics.parsers.c_family_text import compact, normal, normal_many, without
+from archmetrics.parsers.c_family_text import compact, normal, normal_many
 from archmetrics.parsers.c_tables import Shape, StatementRule
 
 _NOT_COUNTED_DIRECTIVES = frozenset({"#pragma once", "#"})
@@ -29,18 +29,24 @@ def _last_row(point: Point) -> int:
     return point.row if point.column else point.row - 1
 
 
-def _previous_token(node: Node) -> Node | None:
-    previous = node.prev_sibling
-    while previous is not None and previous.type == "comment":
-        previous = previous.prev_sibling
-    return previous
+def _previous_token(node: Node, child: Node) -> Node | None:
+    """The token or node before ``child`` of ``node``, comments skipped. (Not
+    ``child.prev_sibling``: tree-sitter finds it by descending from the root again, a cost
+    that grows with the depth, so an `else if` chain of n took n² steps.)"""
+    previous = None
+    for sibling in node.children:
+        if sibling.id == child.id:
+            return previous
+        if sibling.type != "comment":
+            previous = sibling
+    return None
 
 
 def _header(node: Node, rule: StatementRule) -> _Extent | None:
     body = node.child_by_field_name(rule.body_field)
     if body is None:
         return None
-    last = _previous_token(body)
+    last = _previous_token(node, body)
     if last is None:
         return node.start_byte, body.start_byte, node.start_point.row, body.start_point.row, b"", ""
     return node.start_byte, last.end_byte, node.start_point.row, _last_row(last.end_point), b"", ""
@@ -61,7 +67,7 @@ def _label(node: Node) -> _Extent | None:
 
 def _do_while(node: Node) -> _Extent | None:
     condition = node.child_by_field_name("condition")
-    keyword = _previous_token(condition) if condition is not None else None
+    keyword = _previous_token(node, condition) if condition is not None else None
     if keyword is None or keyword.type != "while":
         return None
     last = _last_row(node.end_point)
@@ -92,27 +98,35 @@ class Bodies:
         self._ends = [end for _, end in ranges]
 
     def inside(self, start: int, end: int) -> list[tuple[int, int]]:
-        """The outermost bodies lying wholly inside [start, end)."""
+        """The outermost bodies lying wholly inside [start, end); those inside them are
+        stepped over, not visited (a statement around n nested lambdas would visit n)."""
         cuts: list[tuple[int, int]] = []
-        index = bisect.bisect_left(self._starts, start)
-        last_end = start
-        while index < len(self._starts) and self._starts[index] < end:
-            body_start, body_end = self._starts[index], self._ends[index]
-            if body_start >= last_end and body_end <= end:
+        starts = self._starts
+        index = bisect.bisect_left(starts, start)
+        while index < len(starts) and starts[index] < end:
+            body_start, body_end = starts[index], self._ends[index]
+            if body_end <= end:
                 cuts.append((body_start, body_end))
-                last_end = body_end
-            index += 1
+                index = bisect.bisect_left(starts, body_end, index + 1)
+            else:
+                index += 1  # it runs past the statement (an unbalanced brace, say)
         return cuts
 
 
 def _piece(start: int, end: int, clean: bytes, bodies: Bodies) -> bytes:
-    """The statement's own bytes, comments blanked and nested bodies cut to `{ }`."""
-    raw = clean[start:end]
-    if b"{" in raw:
-        cuts = bodies.inside(start, end)
-        if cuts:
-            raw = without(raw, start, cuts)
-    return raw
+    """The statement's own bytes, comments blanked and nested bodies cut to `{ }`; only
+    the bytes kept are copied (the bodies of nested statements are theirs)."""
+    cuts = bodies.inside(start, end)
+    if not cuts:
+        return clean[start:end]
+    parts: list[bytes] = []
+    position = start
+    for cut_start, cut_end in cuts:
+        parts.append(clean[position:cut_start])
+        parts.append(b"{ }")
+        position = cut_end
+    parts.append(clean[position:end])
+    return b"".join(parts)
 
 
 def _fixed_text(node: Node, start: int, end: int, clean: bytes) -> str | None:

@@ -4,7 +4,10 @@ Two readers apply the same rules (docs/metrics.md, "How a file is read"): the st
 library's (``ast`` and the token stream, python_ast.py) reads every file the running
 interpreter parses; libcst's (python_walk.py) reads the rest, and is imported only then.
 Bad input never raises: a file neither can parse is reported with a warning naming the line,
-and nothing is guessed from it.
+and nothing is guessed from it. Nor may input crash the process or run away: how deep a tree
+either reader builds is bounded (docs/metrics.md, "Limits"), and libcst, whose native parser
+overflows its stack on deep input instead of raising, never sees source nested deeper than
+it can take.
 """
 
 from __future__ import annotations
@@ -18,6 +21,18 @@ from typing import TYPE_CHECKING
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import python_ast
+from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits
+from archmetrics.parsers.python_limits import (
+    LIBCST_DEPTH,
+    LIBCST_ELIFS,
+    LIBCST_WALK_FRAMES,
+    ast_depth,
+    below_interpreter,
+    beyond_libcst,
+    recursion_room,
+    too_deep_for_ast,
+)
+from archmetrics.parsers.python_shown import PendingCall
 
 if TYPE_CHECKING:
     import libcst as cst
@@ -25,32 +40,62 @@ if TYPE_CHECKING:
 _ERROR_AT = re.compile(r"error at (\d+):(\d+)")
 _ERROR_PREFIX = re.compile(r"^(?:parser|tokenizer) error: (?:error at \d+:\d+: )?")
 
+_BRACKETS_MESSAGE = "too many nested parentheses"  # CPython's tokenizer, at 200 levels
 
-def parse(path: str, source: str) -> FileFacts:
+
+class _TooDeep(Exception):
+    """The interpreter gave up on the nesting (``kind``): libcst would fare worse."""
+
+    def __init__(self, kind: str):
+        super().__init__(kind)
+        self.kind = kind
+
+
+def parse(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     """Facts of one Python file (``generated`` is left to the registry)."""
     if "\r" in source:  # Python reads \r\n and lone \r as newlines; so do we
         source = source.replace("\r\n", "\n").replace("\r", "\n")
-    tree = _standard_tree(source)
+    depth = ast_depth(limits)
+    try:
+        tree = _standard_tree(source, depth)
+    except _TooDeep as refusal:
+        return too_deep_for_ast(path, source, refusal.kind, depth, limits)
     if tree is not None:
+        refused = below_interpreter(path, source, depth, limits)
+        if refused is not None:
+            return refused
         try:
             return python_ast.read(path, source, tree)
         except Exception:  # libcst below reads it, the same rules
             pass
-    return parse_with_libcst(path, source)
+    return parse_with_libcst(path, source, limits)
 
 
-def _standard_tree(source: str) -> ast.Module | None:
-    """The running interpreter's syntax tree of ``source``, or None when it rejects it."""
+def _standard_tree(source: str, depth: int = DEFAULT_LIMITS.max_depth) -> ast.Module | None:
+    """The running interpreter's syntax tree of ``source``, at most ``depth`` levels deep,
+    or None when it rejects the source. Raises :class:`_TooDeep` when the interpreter gives
+    up on the nesting, not the syntax."""
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), recursion_room(depth // 3 + 1):
             warnings.simplefilter("ignore")  # "invalid escape sequence" is the author's business
             return ast.parse(source)
-    except (SyntaxError, ValueError, RecursionError, MemoryError, OverflowError):
+    except RecursionError:  # deeper than ``depth``
+        raise _TooDeep("depth") from None
+    except MemoryError:  # the parser's own stack (6,000 rules deep), or memory itself
+        raise _TooDeep("memory") from None
+    except SyntaxError as error:
+        if error.msg == _BRACKETS_MESSAGE:
+            raise _TooDeep("brackets") from None
+        return None
+    except (ValueError, OverflowError):
         return None
 
 
-def parse_with_libcst(path: str, source: str) -> FileFacts:
+def parse_with_libcst(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     """Facts of one Python file through libcst (newlines already normalized)."""
+    refusal = beyond_libcst(path, source, limits)
+    if refusal is not None:
+        return refusal
     import libcst as cst
 
     from archmetrics.parsers.python_walk import FactsWalker
@@ -67,7 +112,8 @@ def parse_with_libcst(path: str, source: str) -> FileFacts:
         return _unparsed(path, 1, f"Python parser failed: {type(error).__name__}: {error}")
     walker = FactsWalker()
     try:
-        module._codegen(walker)
+        with recursion_room(LIBCST_WALK_FRAMES * (LIBCST_DEPTH + LIBCST_ELIFS)):
+            module._codegen(walker)
     except RecursionError:
         return _unparsed(path, 1, "Python source nested too deeply to measure")
     return FileFacts(
@@ -77,7 +123,9 @@ def parse_with_libcst(path: str, source: str) -> FileFacts:
         functions=tuple(f for f in walker.functions if f is not None),
         classes=tuple(c for c in walker.classes if c is not None),
         dependencies=tuple(walker.dependencies),
-        call_sites=tuple(c for c in walker.calls if c is not None),
+        call_sites=tuple(
+            c.site() if isinstance(c, PendingCall) else c for c in walker.calls if c is not None
+        ),
         sloc=walker.sloc(source),
     )
 

@@ -34,6 +34,7 @@ from archmetrics.parsers.python_ast_rules import (
     statement_text,
 )
 from archmetrics.parsers.python_lex import Unreadable
+from archmetrics.parsers.python_shown import PendingCall
 
 
 def read(path: str, source: str, tree: ast.Module) -> FileFacts:
@@ -52,7 +53,9 @@ def read(path: str, source: str, tree: ast.Module) -> FileFacts:
         functions=tuple(f for f in reader.functions if f is not None),
         classes=tuple(c for c in reader.classes if c is not None),
         dependencies=tuple(reader.dependencies),
-        call_sites=tuple(call for _, call in reader.calls),
+        call_sites=tuple(
+            call.site() if isinstance(call, PendingCall) else call for _, call in reader.calls
+        ),
         sloc=reader.sloc(),
     )
 
@@ -151,12 +154,23 @@ class _Reader(ExpressionReader):
             self.body(orelse, target, docstrings=False)
 
     def if_(self, node: ast.If, target: Frame | None) -> None:
+        """An ``if`` and its ``elif`` chain, in a loop: ``ast`` nests each ``elif`` in the
+        ``orelse`` of the one before, and generated chains run to thousands."""
+        text = self.tokens.text
         first = self.first(node)
-        kind = "elif" if self.tokens.text[first] == "elif" else "if"
-        self.header(kind, first, self.end(node.test), target)
-        self.expressions([node.test], target)
-        self.body(node.body, target, docstrings=False)
-        self.else_(node.orelse, target, None)
+        kind = "elif" if text[first] == "elif" else "if"
+        while True:
+            self.header(kind, first, self.end(node.test), target)
+            self.expressions([node.test], target)
+            self.body(node.body, target, docstrings=False)
+            orelse = node.orelse
+            if len(orelse) != 1 or type(orelse[0]) is not ast.If:
+                break
+            first = self.first(orelse[0])
+            if text[first] != "elif":
+                break  # `else:` holding an `if`: an indented block, read as one
+            node, kind = orelse[0], "elif"
+        self.else_(orelse, target, None)
 
     def loop(self, node: ast.For | ast.AsyncFor | ast.While, target: Frame | None) -> None:
         if type(node) is ast.While:

@@ -11,23 +11,32 @@ from __future__ import annotations
 import ast
 from collections.abc import Callable
 
-from archmetrics.facts import Argument, Literal
+from archmetrics.facts import Literal
 from archmetrics.parsers.python_lex import Tokens, Unreadable
+from archmetrics.parsers.python_shown import Text
 
 EndOf = Callable[[ast.AST], int]  # a node -> the index of the token after it
-CallParts = tuple[str, str, str | None, tuple[Argument, ...]]  # callee, name, receiver, args
+ArgumentParts = tuple[Text, Literal, bool, str | None]  # text, value, is_literal, keyword
+CallParts = tuple[Text, str | None, Text | None, tuple[ArgumentParts, ...]]
+"""Callee, name (None: the callee's text), receiver, arguments; texts as token ranges."""
 
 
 def dotted(node: ast.expr) -> str | None:
-    """``a.b.c`` for a Name/Attribute chain, else None."""
+    """``a.b.c`` for a Name/Attribute chain, else None (a loop: chains can be long)."""
     if type(node) is ast.Name:
         return node.id
-    if type(node) is ast.Constant and (node.value is None or type(node.value) is bool):
-        return str(node.value)  # libcst reads True, False and None as names
-    if type(node) is ast.Attribute:
-        base = dotted(node.value)
-        return None if base is None else f"{base}.{node.attr}"
-    return None
+    names = []
+    while type(node) is ast.Attribute:
+        names.append(node.attr)
+        node = node.value
+    if type(node) is ast.Name:
+        names.append(node.id)
+    elif type(node) is ast.Constant and (node.value is None or type(node.value) is bool):
+        names.append(str(node.value))  # libcst reads True, False and None as names
+    else:
+        return None
+    names.reverse()
+    return ".".join(names)
 
 
 def call_parts(
@@ -36,12 +45,12 @@ def call_parts(
     first: int,
     end_of: EndOf,
     value: tuple[int, int] | None,
-) -> tuple[CallParts, int]:
+) -> tuple[CallParts, int, int]:
     """Callee, name, receiver and arguments of the call whose tokens start at ``first``
     (after the call's own parentheses) and whose callee ends before token ``func_end``;
-    also the index of the call's closing ``)``. ``end_of`` gives the token after a node;
-    ``value`` is the token range of the receiver expression, for a parenthesized callee
-    whose receiver is not a dotted name."""
+    also the indexes of the call's own ``(`` and ``)``. ``end_of`` gives the token after a
+    node; ``value`` is the token range of the receiver expression, for a parenthesized
+    callee whose receiver is not a dotted name."""
     text = tokens.text
     func_end = open_ = end_of(node.func)
     while text[open_] == ")":
@@ -50,23 +59,23 @@ def call_parts(
     if text[open_] != "(" or close is None:
         raise Unreadable(f"no argument list after the callee at line {tokens.starts[first]}")
     func = node.func
-    callee = dotted(func) or tokens.joined(first, open_)
-    receiver = None
+    callee: Text = dotted(func) or (first, open_)
+    receiver: Text | None = None
+    name = None
     if type(func) is ast.Attribute:
         name = func.attr
         receiver = dotted(func.value)
         if receiver is None and open_ == func_end:  # drop "." and the attribute name
-            receiver = tokens.joined(first, open_ - 2)
+            receiver = (first, open_ - 2)
         elif receiver is None and value is not None:
-            receiver = tokens.joined(*value)
-    else:
-        name = callee
-    return (callee, name, receiver, _arguments(tokens, node, open_, close, end_of)), close
+            receiver = value
+    arguments = _arguments(tokens, node, open_, close, end_of)
+    return (callee, name, receiver, arguments), open_, close
 
 
 def _arguments(
     tokens: Tokens, node: ast.Call, open_: int, close: int, end_of: EndOf
-) -> tuple[Argument, ...]:
+) -> tuple[ArgumentParts, ...]:
     """The arguments between the call's ``(`` at ``open_`` and ``)`` at ``close``: each runs
     from the comma after the one before (its own parentheses included) to the end of its
     expression and any ``)`` closing around it."""
@@ -87,21 +96,21 @@ def _arguments(
     return tuple(arguments)
 
 
-def _argument(tokens: Tokens, item: ast.expr | ast.keyword, first: int, end: int) -> Argument:
+def _argument(tokens: Tokens, item: ast.expr | ast.keyword, first: int, end: int) -> ArgumentParts:
     if isinstance(item, ast.keyword):
         if item.arg is None:  # **mapping
-            return Argument(tokens.joined(first, end))
-        is_literal, value = literal(item.value, tokens.text[first + 2 : end])
-        return Argument(tokens.joined(first + 2, end), value, is_literal, item.arg)
+            return (first, end), None, False, None
+        is_literal, value = literal(item.value, tokens.text, first + 2, end)
+        return (first + 2, end), value, is_literal, item.arg
     if isinstance(item, ast.Starred):
-        return Argument(tokens.joined(first, end))
-    is_literal, value = literal(item, tokens.text[first:end])
-    return Argument(tokens.joined(first, end), value, is_literal)
+        return (first, end), None, False, None
+    is_literal, value = literal(item, tokens.text, first, end)
+    return (first, end), value, is_literal, None
 
 
-def literal(node: ast.expr, written: list[str]) -> tuple[bool, Literal]:
-    """(True, value) for a literal argument (``written``: its tokens): str, bytes (as
-    Latin-1 text), int, float, a negative number, bool, None, an f-string without
+def literal(node: ast.expr, text: list[str], first: int, end: int) -> tuple[bool, Literal]:
+    """(True, value) for a literal argument (its tokens: ``text[first:end]``): str, bytes
+    (as Latin-1 text), int, float, a negative number, bool, None, an f-string without
     placeholders. A string concatenated with an f-string is not one: libcst evaluates no
     such concatenation."""
     if isinstance(node, ast.Constant):
@@ -112,7 +121,7 @@ def literal(node: ast.expr, written: list[str]) -> tuple[bool, Literal]:
             return True, value.decode("latin-1")
         return False, None  # complex, Ellipsis
     if isinstance(node, ast.JoinedStr):
-        strings = sum(1 for token in written if token != "(" and token != ")")
+        strings = sum(1 for token in text[first:end] if token != "(" and token != ")")
         parts = [
             part.value
             for part in node.values

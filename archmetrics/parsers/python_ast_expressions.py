@@ -21,6 +21,7 @@ from archmetrics.parsers.python_ast_rules import (
     replacement_fields,
 )
 from archmetrics.parsers.python_lex import LineOffsets, Tokens, Unreadable
+from archmetrics.parsers.python_shown import PendingCall, Shown, call_site, texts_of
 
 # Fields that never hold an expression (names, operators, flags), skipped by the walk.
 _LEAF_FIELDS = frozenset(
@@ -49,8 +50,9 @@ class ExpressionReader:
         self.source = source
         self.offset = LineOffsets(source)
         self.tokens = Tokens(source)
+        self.tokens.texts = Shown(self.tokens.text, precise=True)
         self.funcs: list[Frame] = []  # enclosing functions: statements and calls go to [-1]
-        self.calls: list[tuple[tuple[int, int], CallSite]] = []
+        self.calls: list[tuple[tuple[int, int], CallSite | PendingCall]] = []
 
     # -- positions --------------------------------------------------------------------------
     def first(self, node: ast.AST, tokens: Tokens | None = None) -> int:
@@ -147,12 +149,18 @@ class ExpressionReader:
         func = node.func
         if type(func) is ast.Attribute:
             value = tokens.widen(self.first(func.value, tokens), self.end(func.value, tokens))
-        parts, close = call_parts(tokens, node, first, lambda n: self.end(n, tokens), value)
+        parts, open_, close = call_parts(tokens, node, first, lambda n: self.end(n, tokens), value)
         callee, name, receiver, arguments = parts
         span = self.span(*tokens.widen(first, close + 1), tokens=tokens)
-        site = CallSite(callee, name, receiver, span, arguments, self.owner())
+        texts = texts_of(tokens)
         order = (tokens.base + tokens.offsets[first], -(tokens.base + tokens.offsets[close]))
-        self.calls.append((order, site))
+        function = self.owner()
+        if texts.note_call(first, open_, close + 1):  # long: its texts wait for all calls
+            pending = PendingCall(texts, callee, name, receiver, span, arguments, function)
+            self.calls.append((order, pending))
+        else:
+            site = call_site(texts, callee, name, receiver, span, arguments, function)
+            self.calls.append((order, site))
 
     def field_tokens(self, value: ast.expr) -> Tokens:
         """Tokens of an f-string replacement field's expression, read on their own."""

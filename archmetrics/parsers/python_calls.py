@@ -9,60 +9,64 @@ from __future__ import annotations
 
 import libcst as cst
 
-from archmetrics.facts import Argument
+from archmetrics.facts import Literal
 from archmetrics.parsers import python_rules as rules
-from archmetrics.parsers.python_tokens import TokenState, normalized
+from archmetrics.parsers.python_shown import Text
+from archmetrics.parsers.python_tokens import TokenState, shown_text
 
-CallParts = tuple[str, str | None, tuple[Argument, ...]]  # callee, receiver, arguments
+ArgumentParts = tuple[Text, Literal, bool, str | None]  # text, value, is_literal, keyword
+CallParts = tuple[Text, Text | None, tuple[ArgumentParts, ...]]  # callee, receiver, arguments
 
 
 def from_tokens(
     state: TokenState, node: cst.Call, first: int, end: int, starts: list[int]
-) -> CallParts:
-    """Callee, receiver and arguments of a call spanning tokens ``first:end``.
+) -> tuple[Text, Text | None, tuple[ArgumentParts, ...], int, int]:
+    """Callee, receiver and arguments of a call spanning tokens ``first:end``, texts as
+    token ranges, and the indexes of the call's own ``(`` and ``)``.
 
     ``starts`` holds the first token index of each argument.
     """
     close = end - len(node.rpar) - 1  # the call's own ")"
     open_ = (starts[0] if starts else close) - 1  # the call's own "("
     func = node.func
-    callee = rules.dotted(func) or state.text(first + len(node.lpar), open_)
-    receiver = None
+    own = first + len(node.lpar)
+    callee: Text = rules.dotted(func) or (own, open_)
+    receiver: Text | None = None
     if isinstance(func, cst.Attribute):
         receiver = rules.dotted(func.value)
         if receiver is None and not func.lpar:  # drop "." and the attribute name
-            receiver = state.text(first + len(node.lpar), open_ - 2)
-        elif receiver is None:
-            receiver = normalized(func.value)
+            receiver = (own, open_ - 2)
+        elif receiver is None:  # `(f().b)(x)`: the receiver inside the callee's parentheses
+            receiver = (own + len(func.lpar), open_ - len(func.rpar) - 2)
     ends = [*starts[1:], close] if starts else []
     arguments = tuple(
         _argument(state, arg, a, b) for arg, a, b in zip(node.args, starts, ends, strict=True)
     )
-    return callee, receiver, arguments
+    return callee, receiver, arguments, open_, close
 
 
-def _argument(state: TokenState, arg: cst.Arg, first: int, end: int) -> Argument:
+def _argument(state: TokenState, arg: cst.Arg, first: int, end: int) -> ArgumentParts:
     if end > first and state.toks[end - 1] == ",":
         end -= 1
     if arg.keyword is not None:
         first += 2  # keyword and "="
     is_literal, value = rules.literal(arg.value) if not arg.star else (False, None)
     keyword = arg.keyword.value if arg.keyword is not None else None
-    return Argument(state.text(first, end), value, is_literal, keyword)
+    return (first, end), value, is_literal, keyword
 
 
 def from_nodes(node: cst.Call) -> CallParts:
-    """Callee, receiver and arguments of a call whose tokens cannot be sliced."""
+    """Callee, receiver and arguments of a call whose tokens cannot be sliced (inside an
+    f-string): each text regenerated on its own."""
     func = node.func
-    callee = rules.dotted(func) or normalized(func)
+    callee = rules.dotted(func) or shown_text(func)
     receiver = None
     if isinstance(func, cst.Attribute):
-        receiver = rules.dotted(func.value) or normalized(func.value)
+        receiver = rules.dotted(func.value) or shown_text(func.value)
     arguments = []
     for arg in node.args:
-        text = normalized(arg.value)
+        text = shown_text(arg.value, arg.star)
         is_literal, value = rules.literal(arg.value) if not arg.star else (False, None)
         keyword = arg.keyword.value if arg.keyword is not None else None
-        shown = f"{arg.star} {text}" if arg.star else text
-        arguments.append(Argument(shown, value, is_literal, keyword))
+        arguments.append((text, value, is_literal, keyword))
     return callee, receiver, tuple(arguments)

@@ -18,6 +18,10 @@ import tokenize
 from bisect import bisect_left, bisect_right
 from itertools import accumulate, chain, compress, count, repeat
 from operator import add, ne
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from archmetrics.parsers.python_shown import Shown
 
 _SKIPPED = frozenset(
     {
@@ -35,7 +39,7 @@ _GLUE_END = frozenset(getattr(tokenize, n, -1) for n in ("FSTRING_END", "TSTRING
 _OPENERS = {"(": ")", "[": "]", "{": "}"}
 _CLOSERS = frozenset(_OPENERS.values())
 # A "(" after one of these opens a call's arguments, not parentheses around an expression.
-_NOT_OPERANDS = frozenset(keyword.kwlist) - {"True", "False", "None"}
+NOT_OPERANDS = frozenset(keyword.kwlist) - {"True", "False", "None"}
 
 
 class Unreadable(Exception):
@@ -64,6 +68,7 @@ class Tokens:
         "starts",
         "statement_parens",
         "text",
+        "texts",
     )
 
     def __init__(self, source: str, base: int = 0, first_line: int = 1):
@@ -75,6 +80,7 @@ class Tokens:
         self.closing: dict[int, int] = {}
         self.soft_keywords: set[int] = set()  # "match" and "case" where they are keywords
         self.statement_parens: set[int] = set()  # "(" of a statement: `with (a, b):`
+        self.texts: Shown | None = None  # call-site texts, made when first asked for
         self.base = base
         _read(self, source, first_line)
         self._at_start = dict(zip(self.offsets, count()))
@@ -122,7 +128,7 @@ class Tokens:
         before = self.text[index - 1]
         if before in _CLOSERS:
             return True
-        if index - 1 in self.soft_keywords or before in _NOT_OPERANDS:
+        if index - 1 in self.soft_keywords or before in NOT_OPERANDS:
             return False
         head = before[0]
         return head.isalnum() or head in "_'\"" or not head.isascii()
@@ -162,7 +168,7 @@ _BLANKS = r"(?:[ \t\f\n]|\\\n|#[^\n]*)*+"  # blanks, newlines, continuations, co
 _NAME = r"(?![rRbBfFuU]{1,2}['\"])[^\W\d]\w*"
 _NUMBER = "(?=[0-9.])" + re.sub(r"(?<!\\)\((?!\?)", "(?:", tokenize.Number)  # groups dropped
 _OPERATOR = r"\.\.\.|\.|:=?|->|\*\*=?|//=?|<<=?|>>=?|[-+*/%&|^=<>!@]=?|[;{}~]"
-_LEXEME = re.compile(
+LEXEME = re.compile(
     f"({_BLANKS})({_NAME}|[()\\[\\],]|{_NUMBER}|{_OPERATOR}|(?=[\\'\"rRbBfFuU]){_STRING}|\\Z)",
     re.DOTALL,
 )
@@ -192,7 +198,7 @@ def _finish(tokens: Tokens) -> None:
 def _scan(tokens: Tokens, source: str, first_line: int) -> bool:
     """``_read`` by one regular expression; False, ``tokens`` untouched, where it meets
     something it does not know (an identifier character outside ``\\w``, say)."""
-    pieces = _LEXEME.findall(source)
+    pieces = LEXEME.findall(source)
     trailing = 0  # blanks after the last token (matched before the end, \Z)
     while pieces and not pieces[-1][1]:
         trailing += len(pieces.pop()[0])

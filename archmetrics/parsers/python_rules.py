@@ -90,13 +90,16 @@ def _is_text(node: cst.BaseExpression) -> bool:
 
 
 def dotted(node: cst.CSTNode) -> str | None:
-    """``a.b.c`` for a Name/Attribute chain, else None."""
-    if isinstance(node, cst.Name):
-        return node.value
-    if isinstance(node, cst.Attribute):
-        base = dotted(node.value)
-        return None if base is None else f"{base}.{node.attr.value}"
-    return None
+    """``a.b.c`` for a Name/Attribute chain, else None (a loop: chains can be long)."""
+    names = []
+    while isinstance(node, cst.Attribute):
+        names.append(node.attr.value)
+        node = node.value
+    if not isinstance(node, cst.Name):
+        return None
+    names.append(node.value)
+    names.reverse()
+    return ".".join(names)
 
 
 def literal(node: cst.BaseExpression) -> tuple[bool, Literal]:

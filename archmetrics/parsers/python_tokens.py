@@ -162,3 +162,15 @@ def normalized(node: cst.CSTNode) -> str:
     state = TokenState()
     node._codegen(state)
     return state.text(0, len(state.toks))
+
+
+def shown_text(node: cst.CSTNode, star: str = "") -> str:
+    """A node's normalized text as a call site shows it (python_shown.py), after the
+    ``*`` or ``**`` of a starred argument, if any."""
+    from archmetrics.parsers.python_shown import Shown
+
+    state = TokenState()
+    if star:
+        state.toks.append(star)
+    node._codegen(state)
+    return Shown(state.toks).text(0, len(state.toks))

@@ -23,6 +23,7 @@ from archmetrics.facts import (
 )
 from archmetrics.parsers import python_calls as calls
 from archmetrics.parsers import python_rules as rules
+from archmetrics.parsers.python_shown import PendingCall, Shown, call_site
 from archmetrics.parsers.python_tokens import Hook, TokenState
 
 
@@ -53,7 +54,7 @@ class FactsWalker(TokenState):
         self.functions: list[Function | None] = []
         self.classes: list[Class | None] = []
         self.dependencies: list[Dependency] = []
-        self.calls: list[CallSite | None] = []
+        self.calls: list[CallSite | PendingCall | None] = []
         self.docstrings: set[int] = set()
         self.elifs: set[int] = set()
         self.else_kinds: dict[int, str] = {}
@@ -62,6 +63,7 @@ class FactsWalker(TokenState):
         self.call_starts: list[tuple[int, int, list[int]]] = []  # (first token, slot, [line])
         self.arg_starts: dict[int, int] = {}
         self.syntax_starts: dict[int, int] = {}
+        self.shown = Shown(self.toks, precise=True)  # call-site texts
 
     # -- helpers ----------------------------------------------------------------------------
     def span(self, first: int, end: int) -> Span:
@@ -242,13 +244,18 @@ class FactsWalker(TokenState):
         first, slot, (line,) = self.call_starts.pop()
         end = len(self.toks)
         starts = [self.arg_starts.pop(id(arg), first) for arg in node.args]
+        long = False
         if self.fstring_depth:  # inside an f-string the tokens are glued: rebuild the text
             callee, receiver, arguments = calls.from_nodes(node)
         else:
-            callee, receiver, arguments = calls.from_tokens(self, node, first, end, starts)
-        name = node.func.attr.value if isinstance(node.func, cst.Attribute) else callee
+            callee, receiver, arguments, open_, close = calls.from_tokens(
+                self, node, first, end, starts
+            )
+            long = self.shown.note_call(first + len(node.lpar), open_, close + 1)
+        name = node.func.attr.value if isinstance(node.func, cst.Attribute) else None
         span = Span(line, max(line, self.last_line(end)))
-        self.calls[slot] = CallSite(callee, name, receiver, span, arguments, self.owner())
+        made = PendingCall if long else call_site  # a long call's texts wait for all calls
+        self.calls[slot] = made(self.shown, callee, name, receiver, span, arguments, self.owner())
 
 
 def _decision(kind: str) -> Hook:

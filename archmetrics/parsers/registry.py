@@ -9,9 +9,12 @@ from pathlib import PurePosixPath
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import text
+from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, too_large
 
 ParseFunction = Callable[[str, str], FileFacts]
 """(path, decoded source) -> facts. Decoding and binary checks happen before it is called."""
+LimitedParseFunction = Callable[[str, str, ParseLimits], FileFacts]
+"""(path, decoded source, limits) -> facts: a parser that keeps to the per-file limits."""
 
 ENTRY_POINT_GROUP = "archmetrics.languages"
 
@@ -38,34 +41,43 @@ class UnknownLanguage(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class LanguageSpec:
-    """A language: its name and the function that turns its source into facts."""
+    """A language: its name and the function that turns its source into facts.
+
+    ``parse_limited``, when given, is used instead of ``parse`` and is handed the per-file
+    limits (``max_depth``, ``parse_seconds``); ``max_bytes`` holds for every language."""
 
     name: str
     parse: ParseFunction
+    parse_limited: LimitedParseFunction | None = None
+
+    def read(self, path: str, source: str, limits: ParseLimits) -> FileFacts:
+        if self.parse_limited is not None:
+            return self.parse_limited(path, source, limits)
+        return self.parse(path, source)
 
 
-def _python(path: str, source: str) -> FileFacts:
+def _python(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     from archmetrics.parsers import python
 
-    return python.parse(path, source)
+    return python.parse(path, source, limits)
 
 
-def _c(path: str, source: str) -> FileFacts:
+def _c(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     from archmetrics.parsers import c_family
 
-    return c_family.parse(path, source, Language.C)
+    return c_family.parse(path, source, Language.C, limits)
 
 
-def _cpp(path: str, source: str) -> FileFacts:
+def _cpp(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     from archmetrics.parsers import c_family
 
-    return c_family.parse(path, source, Language.CPP)
+    return c_family.parse(path, source, Language.CPP, limits)
 
 
 BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
-    LanguageSpec(Language.PYTHON, _python),
-    LanguageSpec(Language.C, _c),
-    LanguageSpec(Language.CPP, _cpp),
+    LanguageSpec(Language.PYTHON, _python, _python),
+    LanguageSpec(Language.C, _c, _c),
+    LanguageSpec(Language.CPP, _cpp, _cpp),
 )
 
 
@@ -122,8 +134,17 @@ class LanguageTable:
         raise UnknownLanguage(f"no parser for language {language!r}")
 
 
-def parse_source(path: str, data: bytes, language: str, table: LanguageTable) -> FileFacts:
-    """Facts for one file's bytes. Never raises for bad input: problems become warnings."""
+def parse_source(
+    path: str,
+    data: bytes,
+    language: str,
+    table: LanguageTable,
+    limits: ParseLimits = DEFAULT_LIMITS,
+) -> FileFacts:
+    """Facts for one file's bytes. Never raises for bad input: problems become warnings,
+    and a file over one of the ``limits`` comes back not measured, saying which."""
+    if len(data) > limits.max_bytes:
+        return too_large(path, language, len(data), limits)
     if text.is_binary(data):
         return FileFacts(
             path=path,
@@ -132,7 +153,7 @@ def parse_source(path: str, data: bytes, language: str, table: LanguageTable) ->
             warnings=(ParseWarning(path, 1, "binary file with a source ending; not measured"),),
         )
     source, decode_warning = text.decode(path, data)
-    facts = table.spec(language).parse(path, source)
+    facts = table.spec(language).read(path, source, limits)
     extra: list[ParseWarning] = [decode_warning] if decode_warning else []
     generated = facts.generated or text.declares_generated(source)
     if not extra and generated == facts.generated:
@@ -144,8 +165,10 @@ def parse_source(path: str, data: bytes, language: str, table: LanguageTable) ->
 
 __all__ = [
     "DEFAULT_EXTENSIONS",
+    "DEFAULT_LIMITS",
     "LanguageSpec",
     "LanguageTable",
+    "ParseLimits",
     "ParseWarning",
     "Severity",
     "UnknownLanguage",

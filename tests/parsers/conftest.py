@@ -8,6 +8,7 @@ import warnings
 import pytest
 
 from archmetrics.parsers import python
+from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits
 
 
 @pytest.fixture(params=["ast", "libcst"])
@@ -17,17 +18,17 @@ def python_reader(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatc
     give the same facts. Under ``ast``, a fall-back to libcst on source the interpreter
     parses fails the test: the ``ast`` reader gave up where it should not have."""
     if request.param == "libcst":
-        monkeypatch.setattr(python, "_standard_tree", lambda source: None)
+        monkeypatch.setattr(python, "_standard_tree", lambda source, depth=0: None)
         return "libcst"
     through_libcst = python.parse_with_libcst
 
-    def strict(path: str, source: str) -> object:
+    def strict(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> object:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
                 ast.parse(source)
             except (SyntaxError, ValueError, RecursionError, MemoryError):
-                return through_libcst(path, source)
+                return through_libcst(path, source, limits)
         raise AssertionError(f"the ast reader fell back to libcst on {path}")
 
     monkeypatch.setattr(python, "parse_with_libcst", strict)

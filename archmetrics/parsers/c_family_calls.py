@@ -1,0 +1,171 @@
+"""C and C++ call sites: callee, name, receiver and arguments with their literal values.
+
+Texts of calls nested in long calls are cut (shown.py): they are read by windows from their
+start, and a chain's calls, whose texts all start alike, share one cut text.
+"""
+
+from __future__ import annotations
+
+import bisect
+import re
+from collections.abc import Callable
+
+from tree_sitter import Node
+
+from archmetrics.facts import Argument, CallSite, Literal
+from archmetrics.parsers import shown
+from archmetrics.parsers.c_family_names import in_order, span, text
+from archmetrics.parsers.c_family_text import compact, literal, normal, string_value
+from archmetrics.parsers.text import collapse
+
+_STRINGS = frozenset({"string_literal", "raw_string_literal"})
+_CALLEE = re.compile(r"(.*)(\.|->|::)(~?[A-Za-z_$][\w$]*)\Z", re.DOTALL)
+_SPACE_OR_COMMENT = re.compile(rb"\s|/[/*]")
+
+
+def without_template_arguments(written: str) -> str:
+    """``written`` with its template arguments dropped, inner first, as often as the regular
+    expression ``<[^<>()]*>`` would drop them, in one pass: a group goes unless parentheses
+    stand in it (which then stand in every group around it too)."""
+    kept: list[str] = []
+    groups: list[int] = []  # where each open `<` sits in ``kept``
+    clean = 0  # groups[clean:] hold no parenthesis
+    for char in written:
+        if char == "<":
+            groups.append(len(kept))
+        elif char == ">" and groups:
+            where = groups.pop()
+            if len(groups) >= clean:
+                del kept[where:]
+                continue
+            clean = len(groups)
+        elif char in "()":
+            clean = len(groups)
+        kept.append(char)
+    return "".join(kept)
+
+
+_WINDOW = shown.LIMIT + 256  # bytes first read of a text to be cut
+_MARGIN = 16  # characters past the cut that a window's last, partial token may spoil
+_TAIL = 256  # bytes at the end of a cut callee read for its name
+
+
+class CallSites:
+    """The call sites of one file, texts cut where long calls nest (shown.py)."""
+
+    def __init__(self, nodes: list[Node], data: bytes) -> None:
+        self._nodes = in_order(nodes)
+        self._data = data
+        self._opens: list[int] | None = None  # where each long call's argument list starts
+        # cut texts by where they start and how they are read, with the end of the bytes
+        # read for them: the calls of a chain share one
+        self._cut: dict[tuple[int, Callable[[bytes], str]], tuple[int, str]] = {}
+
+    def sites(self, owner: Callable[[int], str | None]) -> tuple[CallSite, ...]:
+        """Every call site in order; ``owner`` names the function around an offset."""
+        return tuple(self._site(node, owner(node.start_byte)) for node in self._nodes)
+
+    def _site(self, node: Node, function: str | None) -> CallSite:
+        function_node = node.child_by_field_name("function")
+        called = self._callee(function_node)
+        receiver: str | None = None
+        name = called
+        if function_node is not None and function_node.type != "identifier":
+            if called.endswith(shown.CUT):  # the name ends the callee, past the cut
+                end = function_node.end_byte
+                tail = compact(self._data[max(function_node.start_byte, end - _TAIL) : end])
+                found = _CALLEE.match(tail)
+                if found:
+                    receiver, name = called, found.group(3)
+            elif match := _CALLEE.match(called):
+                receiver, name = match.group(1), match.group(3)
+        arguments = node.child_by_field_name("arguments")
+        values: tuple[Argument, ...] = ()
+        if arguments is not None:
+            values = tuple(
+                self._argument(child)
+                for child in arguments.named_children
+                if child.type != "comment"
+            )
+        return CallSite(called, name, receiver or None, span(node), values, function)
+
+    def _callee(self, node: Node | None) -> str:
+        """The called expression's text, template arguments dropped: `Ice::checkedCast`."""
+        if node is None:
+            return ""
+        if node.type == "identifier":
+            return self._data[node.start_byte : node.end_byte].decode("utf-8", "replace")
+        written = self._text(node.start_byte, node.end_byte, compact)
+        if "<" in written and node.type != "parenthesized_expression":
+            written = without_template_arguments(written)
+        return written
+
+    def _argument(self, node: Node) -> Argument:
+        start, end = node.start_byte, node.end_byte
+        if self._holds_call(start, end):
+            return Argument(self._text(start, end, _argument_text))  # no literal holds a call
+        raw = self._data[start:end]
+        kind = node.type
+        if kind == "identifier":
+            return Argument(raw.decode("utf-8", "replace"))
+        written = self._text(start, end, _argument_text, raw)
+        value: Literal = None
+        is_literal = False
+        if kind == "concatenated_string":
+            parts = [child for child in node.named_children if child.type != "comment"]
+            if parts and all(child.type in _STRINGS for child in parts):
+                values = [string_value(text(child, self._data)) for child in parts]
+                is_literal = all(part is not None for part in values)
+                value = "".join(part or "" for part in values) if is_literal else None
+        elif kind == "unary_expression" and raw.startswith(b"-"):
+            operand = node.child_by_field_name("argument")
+            if operand is not None and operand.type == "number_literal":
+                is_literal, number = literal("number_literal", text(operand, self._data))
+                value = -number if isinstance(number, int | float) else None
+        else:
+            is_literal, value = literal(kind, raw)
+        return Argument(written, value, is_literal)
+
+    def _text(
+        self, start: int, end: int, read: Callable[[bytes], str], raw: bytes | None = None
+    ) -> str:
+        """``read`` of bytes ``start:end`` (``raw``, if given); cut if it holds a long call,
+        and then read by growing windows from its start, not whole."""
+        if not self._holds_call(start, end):
+            return read(self._data[start:end] if raw is None else raw)
+        found = self._cut.get((start, read))
+        if found is not None and found[0] <= end:
+            return found[1]  # the same first window: the same cut
+        window = _WINDOW
+        while True:
+            stop = min(end, start + window)
+            written = read(self._data[start:stop])
+            if stop == end or len(written) > shown.LIMIT + _MARGIN:
+                break
+            window *= 2
+        if len(written) <= shown.LIMIT:
+            return written  # not long once read (blanks and comments dropped)
+        written = shown.cut(written)
+        self._cut[(start, read)] = (stop, written)
+        return written
+
+    def _holds_call(self, start: int, end: int) -> bool:
+        """True when bytes ``start:end`` hold a call longer than ``shown.LIMIT`` bytes: its
+        argument list opens among them (a call around the range opens its list outside)."""
+        opens = self._opens
+        if opens is None:
+            lists = (
+                node.child_by_field_name("arguments")
+                for node in self._nodes
+                if node.end_byte - node.start_byte > shown.LIMIT
+            )
+            opens = self._opens = sorted(node.start_byte for node in lists if node is not None)
+        index = bisect.bisect_left(opens, start)
+        return index < len(opens) and opens[index] < end
+
+
+def _argument_text(raw: bytes) -> str:
+    """An argument's text: as written when it has no blanks, else normalized."""
+    if _SPACE_OR_COMMENT.search(raw) is None:
+        return raw.decode("utf-8", "replace")
+    return normal(raw) if b"/" in raw else collapse(raw.decode("utf-8", "replace"))

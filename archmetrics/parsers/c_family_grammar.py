@@ -1,0 +1,136 @@
+"""tree-sitter for C and C++: each language's parser and its one query, and a parse that
+stops when it runs out of time.
+
+The query captures every node the walker needs in one pass on the C side (c_family.py).
+A pattern that names a node's parent, ``(parent (child))``, keeps a partial match open for
+every ``parent`` the query cursor is inside: with a parent type that nests (a block) that
+is n² work on n nested blocks (4,000 nested `if` blocks: 4 s for one such pattern), so the
+patterns here name parents only where they do not nest deeply.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from tree_sitter import Language as TSLanguage
+from tree_sitter import Node, Parser, Point, Query, QueryError, Tree
+
+from archmetrics.facts import Language
+from archmetrics.parsers import c_tables
+
+_CHUNK = 1 << 16  # bytes handed to the parser at a time
+# tree-sitter's query cursor counts depth in 16 bits: past 65,535 levels it drops captures
+# (32,766 of 34,000 chained calls) and slows quadratically (2 s; 36 s at 80,000 levels).
+QUERY_DEPTH = 65_000
+
+
+@dataclass(frozen=True, slots=True)
+class Grammar:
+    """A language's parser and queries, built once per process."""
+
+    parser: Parser
+    query: Query
+    rules: Mapping[str, c_tables.StatementRule]
+
+
+_GRAMMARS: dict[str, Grammar] = {}
+
+
+def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule]) -> list[str]:
+    def known(kind: str, named: bool = True) -> bool:
+        return language.id_for_node_kind(kind, named) is not None
+
+    plain = [kind for kind in rules if kind not in c_tables.SPECIFIERS and known(kind)]
+    specifiers = " ".join(f"({kind})" for kind in c_tables.SPECIFIERS if known(kind))
+    tokens = " ".join(f'"{token}"' for token in c_tables.DECISIONS if known(token, False))
+    classes = " ".join(f"({kind} body: (_))" for kind in c_tables.CLASSES if known(kind))
+    return [
+        "[" + " ".join(f"({kind})" for kind in plain) + "] @stmt",
+        f"[{specifiers}] @specifier",  # kept only where they stand alone (c_family.py)
+        *c_tables.NOT_STATEMENTS,
+        f"[{tokens}] @decision",
+        *c_tables.NOT_DECISIONS,
+        *c_tables.DIRECTIVE_CONDITIONS,
+        f"[{classes}] @class",
+        f"({c_tables.NAMESPACE}) @namespace",
+        "(call_expression) @call",
+        "(comment) @comment",
+        "(ERROR) @error",
+        "(MISSING) @missing",
+        "(template_instantiation (MISSING) @expected)",  # `template class Box<int>;`
+        f"({c_tables.TEMPLATE}) @template",
+        "[" + " ".join(f"({kind})" for kind in c_tables.BODIES) + "] @body",
+    ]
+
+
+def _compiles(language: TSLanguage, pattern: str) -> bool:
+    try:
+        Query(language, pattern)
+    except QueryError:
+        return False  # a node type this grammar does not have (C has no templates)
+    return True
+
+
+def grammar(language: str) -> Grammar:
+    """The parser and queries for ``language`` (C or C++), built on first use."""
+    built = _GRAMMARS.get(language)
+    if built is not None:
+        return built
+    is_c = language == Language.C
+    module = importlib.import_module("tree_sitter_c" if is_c else "tree_sitter_cpp")
+    ts_language = TSLanguage(module.language())
+    rules = c_tables.C_STATEMENTS if is_c else c_tables.CPP_STATEMENTS
+    patterns = [p for p in _patterns(ts_language, rules) if _compiles(ts_language, p)]
+    built = Grammar(Parser(ts_language), Query(ts_language, "\n".join(patterns)), rules)
+    _GRAMMARS[language] = built
+    return built
+
+
+def syntax_tree(parser: Parser, data: bytes, seconds: float) -> Tree | None:
+    """``data`` parsed, or None when the parse takes longer than ``seconds`` (wall clock).
+
+    tree-sitter asks whether to go on every hundred or so steps of its parse; a cut-off
+    parse would resume with the next call, so the parser is reset. (The query that follows
+    the parse is not cut off: py-tree-sitter 0.26's query cursor keeps a pointer to an
+    options record that has gone out of scope when it calls back, and crashes.)
+    """
+    deadline = time.monotonic() + seconds
+
+    def read(offset: int, _: Point) -> bytes:
+        return data[offset : offset + _CHUNK]
+
+    def stop(_offset: int, _has_error: bool) -> bool:
+        return time.monotonic() > deadline
+
+    try:
+        return parser.parse(read, progress_callback=stop)
+    except ValueError:  # "Parsing failed": cut off
+        parser.reset()
+        return None
+
+
+def deeper_than(root: Node, limit: int) -> bool:
+    """True when the tree under ``root`` is more than ``limit`` levels deep.
+
+    A walk that enters only subtrees big enough to be that deep: a subtree of n nodes is at
+    most n - 1 levels deep (``descendant_count`` counts the node itself, and is stored, not
+    counted). An ordinary file costs a step per top-level declaration; a node with a million
+    small children (a one-line table) a step per child."""
+    if root.descendant_count <= limit:
+        return False
+    cursor = root.walk()
+    depth = 0
+    while True:
+        if depth > limit:
+            return True
+        node = cursor.node
+        if node is not None and node.descendant_count > limit - depth and cursor.goto_first_child():
+            depth += 1
+            continue
+        while not cursor.goto_next_sibling():
+            if not cursor.goto_parent():
+                return False
+            depth -= 1
