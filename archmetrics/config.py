@@ -39,16 +39,28 @@ class CouplingSettings:
 
 @dataclass(frozen=True, slots=True)
 class LimitSettings:
-    """What one file may cost (docs/security.md, "Bounded work per file"). A repository's
-    configuration may lower or raise them, up to :data:`LIMIT_CEILINGS`."""
+    """What one file may cost (docs/security.md, "Bounded work per file"; docs/metrics.md,
+    "Limits"). A repository's configuration may lower or raise them, up to
+    :data:`LIMIT_CEILINGS`."""
 
-    file_seconds: float = 120.0  # wall-clock seconds to parse one file
+    file_seconds: float = 120.0  # wall-clock seconds to parse one file (the worker pool)
     worker_memory_mb: int = 4096  # MiB of address space a parser process may add
+    file_mb: float = 16.0  # a larger file is not read (ParseLimits.max_bytes)
+    nesting: int = 20_000  # the deepest syntax tree a reader builds (ParseLimits.max_depth)
+    parse_seconds: float = 20.0  # tree-sitter's parse of one file (ParseLimits.parse_seconds)
 
 
-LIMIT_CEILINGS = {"file-seconds": 3600.0, "worker-memory-mb": 65536}
+LIMIT_CEILINGS: dict[str, float] = {
+    "file-seconds": 3600,
+    "worker-memory-mb": 65536,
+    "file-mb": 1024,
+    "nesting": 60_000,
+    "parse-seconds": 3600,
+}
 """The most a configuration may allow: an untrusted repository can make its own run slow,
 never endless."""
+
+_WHOLE_NUMBERS = {"worker-memory-mb", "nesting"}
 
 
 def _limits(table: Mapping[str, Any], where: str) -> LimitSettings:
@@ -56,7 +68,7 @@ def _limits(table: Mapping[str, Any], where: str) -> LimitSettings:
     values: dict[str, Any] = {}
     for key, value in table.items():
         here, ceiling = f"{where}.{key}", LIMIT_CEILINGS[key]
-        number_types = (int, float) if key == "file-seconds" else (int,)
+        number_types = (int,) if key in _WHOLE_NUMBERS else (int, float)
         if not isinstance(value, number_types) or isinstance(value, bool):
             raise ConfigError(f"{here}: expected a number")
         if not 0 < value <= ceiling:  # NaN fails this too

@@ -10,7 +10,7 @@ from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.workers import Parsed, Task, WorkerLimits, parse_in_workers
 from archmetrics.config import LimitSettings
 from archmetrics.facts import FileFacts, ParseWarning, Severity
-from archmetrics.parsers import LanguageTable
+from archmetrics.parsers import LanguageTable, ParseLimits
 from archmetrics.sources import Snapshot, SourceFile, codec
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import blob_hash
@@ -96,7 +96,7 @@ def parse_all(
             return
         facts = codec.decode(answer.encoded, path)
         results[entry.index] = facts
-        if cache is not None:  # stored as each file arrives: encoded bytes are not held on
+        if cache is not None and answer.cacheable:  # stored as each file arrives
             cache.put_encoded([(entry.blob, language, answer.encoded)])
             cache.remember(entry.blob, facts)
 
@@ -118,8 +118,13 @@ def parse_all(
 
 
 def worker_limits(settings: LimitSettings) -> WorkerLimits:
-    """The configured limits as the worker pool takes them."""
-    return WorkerLimits(settings.file_seconds, settings.worker_memory_mb << 20)
+    """The configured limits as the worker pool and the parsers take them."""
+    parser = ParseLimits(
+        max_bytes=int(settings.file_mb * (1 << 20)),
+        max_depth=settings.nesting,
+        parse_seconds=settings.parse_seconds,
+    )
+    return WorkerLimits(settings.file_seconds, settings.worker_memory_mb << 20, parser)
 
 
 def _payload(snapshot: Snapshot, entry: _Todo) -> Task:

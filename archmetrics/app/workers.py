@@ -35,7 +35,7 @@ from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
-from archmetrics.parsers import LanguageTable, parse_source
+from archmetrics.parsers import DEFAULT_LIMITS, LanguageTable, ParseLimits, parse_source
 from archmetrics.sources import codec
 
 T = TypeVar("T")
@@ -49,6 +49,7 @@ class WorkerLimits:
 
     file_seconds: float = 120.0  # wall-clock time to parse one file
     worker_memory: int = 4 << 30  # bytes of address space per worker process
+    parser: ParseLimits = DEFAULT_LIMITS  # what the parsers themselves refuse (size, depth)
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +59,7 @@ class Parsed:
 
     encoded: bytes | None
     failure: str | None = None
+    cacheable: bool = True  # False: the outcome depended on the clock (a parse cut off)
 
 
 Deliver = Callable[[T, Parsed], None]
@@ -145,8 +147,11 @@ def _worker_main(
 def _parse_one(
     path: str, data: bytes, language: str, table: LanguageTable, limits: WorkerLimits
 ) -> Parsed:
+    started = time.monotonic()
     try:
-        return Parsed(codec.encode(parse_source(path, data, language, table)))
+        facts = parse_source(path, data, language, table, limits.parser)
+        timed_out = not facts.parsed and time.monotonic() - started >= limits.parser.parse_seconds
+        return Parsed(codec.encode(facts), cacheable=not timed_out)
     except MemoryError:
         gc.collect()
         return Parsed(None, f"needed more than {limits.worker_memory >> 20} MiB of memory")

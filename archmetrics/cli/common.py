@@ -11,7 +11,7 @@ from typing import NoReturn
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.config import Settings, load_settings
+from archmetrics.config import LimitSettings, Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.printable import one_line
 from archmetrics.sources.cache import FactsCache, choose_path
@@ -113,6 +113,21 @@ def cache_location(args: argparse.Namespace, settings: Settings) -> Path:
     return choose_path(getattr(args, "cache_path", None), settings.cache_path, settings.source)
 
 
+def limits_salt(settings: Settings) -> str:
+    """The parser limits when they differ from the defaults (facts depend on them), and the
+    stack the parsers may use (their depth limits shrink on a small one)."""
+    from archmetrics.parsers.limits import stack_bytes
+
+    limits = settings.limits
+    parser = (limits.file_mb, limits.nesting, limits.parse_seconds)
+    defaults = LimitSettings()
+    changed = parser != (defaults.file_mb, defaults.nesting, defaults.parse_seconds)
+    stack = stack_bytes()
+    return " ".join(
+        [*(map(str, parser) if changed else []), *([str(stack)] if stack < 8 << 20 else [])]
+    )
+
+
 @contextmanager
 def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsCache | None]:
     """The cache the flags and settings ask for (none with --no-cache or cache = false).
@@ -120,7 +135,7 @@ def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsC
     if getattr(args, "no_cache", False) or not settings.cache:
         yield None
         return
-    with FactsCache(cache_location(args, settings)) as cache:
+    with FactsCache(cache_location(args, settings), limits_salt(settings)) as cache:
         for notice in cache.notices:
             warn(notice)
         shown = len(cache.notices)

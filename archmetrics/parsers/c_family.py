@@ -101,14 +101,14 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
     if tree is None:
         message = (
             f"tree-sitter's parse took longer than {limits.parse_seconds:g} s and was cut off"
-            " (raise ParseLimits.parse_seconds to measure it)"
+            " (raise limits.parse-seconds, ParseLimits.parse_seconds, to measure it)"
         )
         return not_measured(path, str(language), 1, message)
     root = tree.root_node
     depth = min(limits.max_depth, QUERY_DEPTH)
     if deeper_than(root, depth):
         message = f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
-            "the limit is ParseLimits.max_depth (raise it to measure the file)"
+            "the limit is limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
             if depth == limits.max_depth
             else "tree-sitter's query cannot go deeper"
         )

@@ -52,7 +52,7 @@ def too_large(path: str, language: str, size: int, limits: ParseLimits) -> FileF
     """A file over ``max_bytes``."""
     message = (
         f"file is {size:,} bytes; the limit is {limits.max_bytes:,}"
-        " (raise ParseLimits.max_bytes to measure it)"
+        " (raise limits.file-mb, ParseLimits.max_bytes, to measure it)"
     )
     return not_measured(path, language, 1, message)
 

@@ -105,7 +105,7 @@ def too_deep_for_ast(
 def _limit(depth: int, limits: ParseLimits) -> str:
     if depth < limits.max_depth:
         return f"the limit is {depth:,} on this thread's stack (ulimit -s)"
-    return f"the limit is {depth:,} (raise ParseLimits.max_depth to measure it)"
+    return f"the limit is {depth:,} (raise limits.nesting, ParseLimits.max_depth, to measure it)"
 
 
 def beyond_libcst(path: str, source: str, limits: ParseLimits) -> FileFacts | None:

@@ -87,9 +87,14 @@ class CacheInfo:
 class FactsCache:
     """A SQLite store of facts. Use as a context manager; writes are committed on close."""
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, salt: str = ""):
+        """``salt``: what else decides the facts (the parser limits in force when they are
+        not the defaults), so facts made under other limits are never served."""
         self.path = Path(os.path.realpath(path.expanduser()))
-        self.fingerprint = parser_fingerprint()
+        fingerprint = parser_fingerprint()
+        if salt:
+            fingerprint = hashlib.sha256(f"{fingerprint} {salt}".encode()).hexdigest()[:16]
+        self.fingerprint = fingerprint
         self.hits = 0
         self.misses = 0
         self.notices: list[str] = []  # problems recovered from, for the user to see

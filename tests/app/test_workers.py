@@ -203,3 +203,24 @@ def test_workers_exit_when_archmetrics_is_killed(
     finally:
         if process.poll() is None:
             process.kill()
+
+
+def test_parser_limits_come_from_the_configuration_and_key_the_cache(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    """A file over the configured size is reported, naming the key; raising the limit
+    measures it at once (facts made under other limits are not served from the cache)."""
+    big = "x = 1\n" * 400  # 2,400 bytes
+    repo.commit("v1", files={"big.py": big, "deep.py": "y = " + "(" * 150 + "1" + ")" * 150})
+    cache = ["--cache-path", str(tmp_path / "c.sqlite3"), "--format", "json"]
+    config = "[tool.archmetrics.limits]\nfile-mb = 0.001\nnesting = 100\n"
+    repo.write({"pyproject.toml": config})
+    files = _measured(run_cli(["scan", ".", *cache], repo.root).out)
+    [size] = files["big.py"]["warnings"]  # type: ignore[misc]
+    assert "limits.file-mb" in size["message"] and files["big.py"]["loc"] == 0
+    [depth] = files["deep.py"]["warnings"]  # type: ignore[misc]
+    assert "limits.nesting" in depth["message"]
+    repo.write({"pyproject.toml": "[tool.archmetrics.limits]\nnesting = 1000\n"})
+    files = _measured(run_cli(["scan", ".", *cache], repo.root).out)
+    assert files["big.py"]["loc"] == 400 and files["deep.py"]["loc"] == 1
+    assert files["big.py"]["warnings"] == [] and files["deep.py"]["warnings"] == []

@@ -131,7 +131,7 @@ def test_a_tree_deeper_than_max_depth_is_refused_naming_the_limit() -> None:
     assert not facts.parsed
     assert facts.warnings[0].message == (
         "tree-sitter's tree of this file is more than 20,000 levels deep; the limit is"
-        " ParseLimits.max_depth (raise it to measure the file)"
+        " limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
     )
     assert read(in_function("x" + ".m()" * 9_000 + ";")).parsed
 
@@ -209,7 +209,7 @@ def test_a_parse_over_its_time_budget_is_cut_off_and_the_parser_stays_usable() -
     assert not facts.parsed
     assert facts.warnings[0].message == (
         "tree-sitter's parse took longer than 1e-06 s and was cut off"
-        " (raise ParseLimits.parse_seconds to measure it)"
+        " (raise limits.parse-seconds, ParseLimits.parse_seconds, to measure it)"
     )
     small = read(in_function("return x;"), "c")  # not the rest of the cut-off parse
     assert [s.kind for s in small.statements] == ["function", "return"]

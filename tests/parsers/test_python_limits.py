@@ -179,7 +179,7 @@ def test_a_tree_deeper_than_max_depth_is_refused_naming_the_limit() -> None:
     assert warning.line == 2
     assert warning.message == (
         "Python source nested 1,000 levels deep; the limit is 500"
-        " (raise ParseLimits.max_depth to measure it)"
+        " (raise limits.nesting, ParseLimits.max_depth, to measure it)"
     )
 
 
@@ -213,7 +213,8 @@ def test_a_file_over_max_bytes_is_not_read() -> None:
     facts = read("x = 1\n" * 100, ParseLimits(max_bytes=500))
     assert not facts.parsed
     assert facts.warnings[0].message == (
-        "file is 600 bytes; the limit is 500 (raise ParseLimits.max_bytes to measure it)"
+        "file is 600 bytes; the limit is 500"
+        " (raise limits.file-mb, ParseLimits.max_bytes, to measure it)"
     )
 
 
