@@ -31,6 +31,7 @@ from archmetrics.parsers.c_family_grammar import (
     grammar,
     syntax_tree,
 )
+from archmetrics.parsers.c_family_macros import blank_macros
 from archmetrics.parsers.c_family_names import (
     Scopes,
     function_name,
@@ -94,26 +95,83 @@ def hide_extern_c_guards(data: bytes) -> bytes:
     return _EXTERN_C_GUARD.sub(lambda m: m.group(1) + b" " * len(m.group(2)), data)
 
 
+@dataclass(slots=True)
+class Reading:
+    """One parse of a file's bytes (as written, or with macros blanked) and its captures.
+    Texts are always read from the bytes as written: blanking keeps every offset."""
+
+    data: bytes
+    root: Node
+    found: dict[str, list[Node]]
+    damage: tuple[int, int]  # bytes inside outermost ERROR nodes, tokens the parser invented
+
+    @classmethod
+    def of(cls, built: Grammar, data: bytes, limits: ParseLimits) -> Reading | str:
+        """The reading of ``data``, or why there is none (a limit)."""
+        tree = syntax_tree(built.parser, data, limits.parse_seconds)
+        if tree is None:
+            return (
+                f"tree-sitter's parse took longer than {limits.parse_seconds:g} s and was cut"
+                " off (raise limits.parse-seconds, ParseLimits.parse_seconds, to measure it)"
+            )
+        root = tree.root_node
+        depth = min(limits.max_depth, QUERY_DEPTH)
+        if deeper_than(root, depth):
+            return f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
+                "the limit is limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
+                if depth == limits.max_depth
+                else "tree-sitter's query cannot go deeper"
+            )
+        found = QueryCursor(built.query).captures(root)
+        return cls(data, root, found, _damage(found))
+
+    def bodies(self) -> list[tuple[int, int]]:
+        """Byte ranges of the function bodies this parse found."""
+        ranges = []
+        for node in self.found.get("stmt", []):
+            body = node.child_by_field_name("body") if node.type == c_tables.FUNCTION else None
+            if body is not None:
+                ranges.append((body.start_byte, body.end_byte))
+        return ranges
+
+
+def _damage(found: dict[str, list[Node]]) -> tuple[int, int]:
+    lost, last_end = 0, -1
+    for node in in_order(found.get("error", [])):
+        if node.start_byte >= last_end:
+            lost += node.end_byte - node.start_byte
+            last_end = node.end_byte
+    return lost, len(found.get("missing", []))
+
+
 def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
-    tree = syntax_tree(built.parser, data, limits.parse_seconds)
-    if tree is None:
-        message = (
-            f"tree-sitter's parse took longer than {limits.parse_seconds:g} s and was cut off"
-            " (raise limits.parse-seconds, ParseLimits.parse_seconds, to measure it)"
-        )
-        return not_measured(path, str(language), 1, message)
-    root = tree.root_node
-    depth = min(limits.max_depth, QUERY_DEPTH)
-    if deeper_than(root, depth):
-        message = f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
-            "the limit is limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
-            if depth == limits.max_depth
-            else "tree-sitter's query cannot go deeper"
-        )
-        return not_measured(path, str(language), 1, message)
-    found = QueryCursor(built.query).captures(root)
+    reading = Reading.of(built, blank_macros(data, names=limits.c_macros, first=True), limits)
+    if isinstance(reading, str):
+        return not_measured(path, str(language), 1, reading)
+    if reading.root.has_error:
+        reading = _recover(built, reading, limits)
+    return _facts(path, language, built, reading, data)
+
+
+def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
+    """The first parse had errors: parse again with the macros tree-sitter cannot know
+    blanked (c_family_macros.py), and keep whichever parse lost less."""
+    blanked = blank_macros(reading.data, reading.bodies(), limits.c_macros)
+    if blanked == reading.data:
+        return reading
+    second = Reading.of(built, blanked, limits)
+    if isinstance(second, str) or second.damage >= reading.damage:
+        return reading
+    return second
+
+
+def _facts(
+    path: str, language: Language, built: Grammar, reading: Reading, data: bytes
+) -> FileFacts:
+    """The facts of ``reading``'s tree, with every text taken from ``data`` as written."""
+    root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
     slots = _functions(found.get("stmt", []), data, scopes)

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import sys
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from archmetrics.facts import FileFacts, ParseWarning, Severity
+from archmetrics.parsers.c_family_macros import MacroNames
 
 _MIB = 1 << 20
 _REFERENCE_STACK = 8 * _MIB  # the main thread's stack on Linux and macOS by default
@@ -26,12 +27,15 @@ class ParseLimits:
     syntax tree a reader builds or walks (Python: each bracket, each operator of a chain
     such as ``a + b + c``, each ``elif`` is a level; C and C++: tree-sitter's tree, whose
     query goes no deeper than 65,000). ``parse_seconds``: tree-sitter's parse of one C or
-    C++ file is cut off after this much wall-clock time.
+    C++ file is cut off after this much wall-clock time. ``c_macros``: not a limit but the
+    one other thing a parser is told, the C/C++ macros the configuration names
+    (``[tool.archmetrics.macros]``, docs/metrics.md "Macros").
     """
 
     max_bytes: int = 16 * _MIB
     max_depth: int = 20_000
     parse_seconds: float = 20.0
+    c_macros: MacroNames = field(default_factory=MacroNames)
 
     def __post_init__(self) -> None:
         for name in ("max_bytes", "max_depth", "parse_seconds"):

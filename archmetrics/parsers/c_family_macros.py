@@ -1,0 +1,137 @@
+"""Macros tree-sitter cannot know, blanked before a second parse (docs/metrics.md, "Macros").
+
+tree-sitter reads the text before preprocessing, so a macro that stands where the grammar
+expects syntax (an export macro between ``class`` and the name, a thread-safety annotation
+after a declarator, a namespace-opening macro on a line of its own) turns good code into
+ERROR nodes, and everything inside them is lost. Only for a file whose first parse has
+errors, each such macro is overwritten with spaces (every byte offset and line stays) and
+the file parsed again; the parse with fewer errors wins. A macro is recognised by its
+place and its spelling (``ALL_CAPS``, as macros are written), or because the configuration
+lists it (``[tool.archmetrics.macros]``). Every rule names where it applies: *anywhere*, or
+only *between declarations* (outside the function bodies of the first parse), where a
+``NAME(args)`` after a ``)`` cannot be a call.
+"""
+
+from __future__ import annotations
+
+import bisect
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+_MACRO = rb"(?:[A-Z_][A-Z0-9_]*[A-Z][A-Z0-9_]*)"
+_ARGS = rb"(?:\s*\((?:[^()]|\((?:[^()]|\([^()]*\))*\))*\))"
+_NAME = rb"[A-Za-z_]\w*"
+_QUALIFIERS = rb"(?:\s*(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*"
+
+
+@dataclass(frozen=True, slots=True)
+class MacroNames:
+    """Macros the configuration names: ``attribute`` macros expand to nothing a metric counts
+    (export, annotation, alignment macros), ``function`` macros head a function definition
+    (``TEST(Suite, Name) { ... }``)."""
+
+    attribute: tuple[str, ...] = ()
+    function: tuple[str, ...] = ()
+
+
+def _attribute(names: Sequence[str]) -> bytes:
+    """The macro spelling: ALL_CAPS, or one of ``names``."""
+    listed = b"|".join(re.escape(n.encode()) for n in names)
+    return rb"(?:" + _MACRO + (rb"|" + listed if listed else b"") + rb")\b"
+
+
+Rule = tuple[re.Pattern[bytes], bool, bool]
+"""(pattern whose group 1 is blanked, applies between declarations only, applies before the
+first parse: a misreading that gives tree-sitter no error, as a class named after its macro)."""
+
+
+def _rules(names: MacroNames) -> tuple[Rule, ...]:
+    macro = _attribute(names.attribute)
+    return (
+        # class FOO_EXPORT Name : / {     struct PACKED Name {     class LOCKABLE(x) Name
+        (re.compile(rb"\b(?:class|struct|union)\s+(" + macro + _ARGS + rb"?)\s+(?=" + _NAME
+                    + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))"), False, True),
+        # class Name PROTOBUF_FINAL : Base {
+        (re.compile(rb"\b(?:class|struct|union)\s+" + _NAME + rb"\s+(?!final\b)(" + macro
+                    + _ARGS + rb"?)(?=\s*(?::(?!:)|\{))"), False, True),
+        # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT
+        (re.compile(rb"(?m)^[ \t]*(" + macro + rb")[ \t]*(?://[^\n]*)?$"), False, False),
+        # void Lock() EXCLUSIVE_LOCKS_REQUIRED(mu_);   int f() const OVERRIDE {
+        (re.compile(rb"\)" + _QUALIFIERS + rb"\s*((?:" + macro + _ARGS + rb"?\s*)+)(?=;|\{|=[^=]"
+                    + rb"|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"), True, False),
+        # a macro call alone on its line, not heading a body: RAPIDJSON_DIAG_OFF(effc++)
+        (re.compile(rb"(?m)^[ \t]*(" + macro + _ARGS + rb")[ \t]*(?://[^\n]*)?$(?!\s*[{:,.=])"),
+         True, False),
+        # if EQ("a") {   while NOT_DONE(x) {
+        (re.compile(rb"\b(?:if|while|switch)\s+(?!constexpr\b)(" + _NAME + rb")(?=\s*\()"), False,
+         False),
+    )  # fmt: skip
+
+
+_LINE_RULES = frozenset({2, 4})  # the rules for a macro alone on its line
+
+_RULES: dict[MacroNames, tuple[Rule, ...]] = {}
+_LITERALS = re.compile(
+    rb'R"([^()\\ ]{0,16})\((?:.|\n)*?\)\1"|"(?:\\.|[^"\\\n])*"|\'(?:\\.|[^\'\\\n])*\''
+    rb"|//[^\n]*|/\*(?:.|\n)*?\*/"
+)
+_ENUM_OR_VALUE = re.compile(rb"(?:\benum\b[^;{}]*|=\s*)\{\s*$")
+_CONTINUING = frozenset(b",(=|&+-*/?:<[!~%^")
+
+
+def _standalone(data: bytes, start: int) -> bool:
+    """Whether a macro at ``start`` begins a declaration or statement of its own: not an
+    enumerator or an operand (``RED,\n GREEN\n}``, ``x = a +\n MAX``)."""
+    before = data[max(0, start - 200) : start].rstrip()
+    if not before:
+        return True
+    if before[-1] in _CONTINUING:
+        return False
+    return not (before.endswith(b"{") and _ENUM_OR_VALUE.search(before))
+
+
+class _Ranges:
+    """Sorted, non-overlapping byte ranges, asked whether they hold an offset."""
+
+    def __init__(self, spans: list[tuple[int, int]]) -> None:
+        self._spans = sorted(spans)
+        self._starts = [start for start, _ in self._spans]
+
+    def __contains__(self, offset: object) -> bool:
+        assert isinstance(offset, int)
+        index = bisect.bisect_right(self._starts, offset) - 1
+        return index >= 0 and offset < self._spans[index][1]
+
+
+def blank_macros(
+    data: bytes,
+    bodies: Iterable[tuple[int, int]] = (),
+    names: MacroNames = MacroNames(),
+    first: bool = False,
+) -> bytes:
+    """``data`` with the macros the rules recognise overwritten by spaces. ``bodies``: the
+    byte ranges of function bodies (rules marked *between declarations* skip them);
+    ``first``: only the rules that run before the first parse."""
+    rules = _RULES.get(names)
+    if rules is None:
+        rules = _RULES.setdefault(names, _rules(names))
+    hits = [
+        (number, found, between)
+        for number, (pattern, between, before) in enumerate(rules)
+        if before or not first
+        for found in pattern.finditer(data)
+    ]
+    if not hits:
+        return data
+    in_body = _Ranges(list(bodies))
+    literal = _Ranges([found.span() for found in _LITERALS.finditer(data)])
+    out = bytearray(data)
+    for number, found, between in hits:
+        start, end = found.span(1)
+        if start in literal or (between and start in in_body):
+            continue
+        if number in _LINE_RULES and not _standalone(data, found.start()):
+            continue
+        out[start:end] = re.sub(rb"[^\n]", b" ", found.group(1))
+    return bytes(out)
