@@ -23,6 +23,7 @@ from archmetrics.facts import (
     Span,
 )
 from archmetrics.parsers import c_tables
+from archmetrics.parsers.c_family_branches import ALL, Conditionals
 from archmetrics.parsers.c_family_calls import CallSites
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
@@ -40,6 +41,7 @@ from archmetrics.parsers.c_family_names import (
     typedef_names,
 )
 from archmetrics.parsers.c_family_outline import classes, includes, warnings
+from archmetrics.parsers.c_family_regions import Choice, Layout, choose
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
 from archmetrics.parsers.c_family_text import blank_comments, sloc
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, not_measured
@@ -125,6 +127,10 @@ class Reading:
         found = QueryCursor(built.query).captures(root)
         return cls(data, root, found, _damage(found))
 
+    def standalone(self) -> list[Node]:
+        """The type specifiers that are a statement of their own (``struct S { ... };``)."""
+        return _standalone(self.root, self.found.get("specifier", []))
+
     def bodies(self) -> list[tuple[int, int]]:
         """Byte ranges of the function bodies this parse found."""
         ranges = []
@@ -144,6 +150,26 @@ def _damage(found: dict[str, list[Node]]) -> tuple[int, int]:
     return lost, len(found.get("missing", []))
 
 
+#: Spellings with one branch of each #if group kept, tried after the one that keeps them all.
+BRANCH_SPELLINGS = 3
+
+
+@dataclass(slots=True)
+class Composite:
+    """What the facts are read from: the captures of the file as written, and inside each
+    region it could not read, those of the spelling that read the region best
+    (c_family_regions.py), with the decisions of the directives a spelling blanked."""
+
+    root: Node
+    found: dict[str, list[Node]]
+    standalone: list[Node]
+    directive_decisions: list[tuple[int, str, int]] = field(default_factory=list)
+
+    @classmethod
+    def of(cls, reading: Reading) -> Composite:
+        return cls(reading.root, reading.found, reading.standalone())
+
+
 def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
@@ -152,7 +178,8 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
         return not_measured(path, str(language), 1, reading)
     if reading.root.has_error:
         reading = _recover(built, reading, limits)
-    return _facts(path, language, built, reading, data)
+    composite = _branches(built, reading, limits) if reading.root.has_error else None
+    return _facts(path, language, built, composite or Composite.of(reading), data)
 
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
@@ -167,10 +194,72 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
     return second
 
 
+def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composite | None:
+    """Where ``reading`` has errors, the file read again without its #if directives (every
+    branch kept, then one branch at a time: c_family_branches.py), region by region."""
+    conditionals = Conditionals(reading.data)
+    if not conditionals.groups:
+        return None
+    base = Layout(reading.found, reading.data)
+    readings: list[Reading] = []
+    layouts: list[Layout] = []
+    choices: list[Choice] = []
+    for branch in [ALL, *range(min(conditionals.most_branches, BRANCH_SPELLINGS))]:
+        spelling, set_aside = conditionals.spelling(branch)
+        other = Reading.of(built, spelling, limits)
+        if isinstance(other, str):
+            continue
+        readings.append(other)
+        layouts.append(Layout(other.found, reading.data, set_aside))
+        choices = choose(base, layouts)
+        if _all_read(base, layouts, choices):
+            break
+    if not choices:
+        return None
+    return _merge(reading, readings, choices, conditionals)
+
+
+def _all_read(base: Layout, layouts: list[Layout], choices: list[Choice]) -> bool:
+    """Whether every damaged region of ``base`` is read without damage by its choice."""
+    starts = [choice.start for choice in choices]
+    for start, end in base.damaged:
+        index = bisect.bisect_right(starts, start) - 1
+        if index < 0 or end > choices[index].end:
+            return False
+    return all(layouts[c.reader].damage(c.start, c.end) == (0, 0) for c in choices)
+
+
+def _merge(
+    base: Reading, readings: list[Reading], choices: list[Choice], conditionals: Conditionals
+) -> Composite:
+    """``base``'s captures outside the chosen regions, the chosen readings' inside."""
+    starts = [choice.start for choice in choices]
+
+    def outside(node: Node) -> bool:
+        index = bisect.bisect_right(starts, node.start_byte) - 1
+        return index < 0 or node.end_byte > choices[index].end
+
+    found = {name: [n for n in nodes if outside(n)] for name, nodes in base.found.items()}
+    standalone = [node for node in base.standalone() if outside(node)]
+    decisions: list[tuple[int, str, int]] = []
+    directives = conditionals.decisions()
+    for choice in choices:
+        chosen = readings[choice.reader]
+
+        def inside(node: Node, choice: Choice = choice) -> bool:
+            return choice.start <= node.start_byte and node.end_byte <= choice.end
+
+        for name, nodes in chosen.found.items():
+            found.setdefault(name, []).extend(filter(inside, nodes))
+        standalone.extend(filter(inside, chosen.standalone()))
+        decisions.extend(d for d in directives if choice.start <= d[0] < choice.end)
+    return Composite(base.root, found, standalone, decisions)
+
+
 def _facts(
-    path: str, language: Language, built: Grammar, reading: Reading, data: bytes
+    path: str, language: Language, built: Grammar, reading: Composite, data: bytes
 ) -> FileFacts:
-    """The facts of ``reading``'s tree, with every text taken from ``data`` as written."""
+    """The facts of ``reading``'s captures, with every text taken from ``data`` as written."""
     root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
@@ -180,14 +269,15 @@ def _facts(
     guard = include_guard(root, data)
     if guard is not None:
         skip.add(guard)
-    standalone = _standalone(root, found.get("specifier", []))
-    nodes = in_order(node for node in found.get("stmt", []) + standalone if node.id not in skip)
+    nodes = in_order(
+        node for node in found.get("stmt", []) + reading.standalone if node.id not in skip
+    )
     comments = sorted((n.start_byte, n.end_byte) for n in found.get("comment", []))
     clean = blank_comments(data, comments)
     facts_statements = statements(
         nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
     )
-    _decisions(found, owner)
+    _decisions(found, owner, reading.directive_decisions)
     return FileFacts(
         path=path,
         language=str(language),
@@ -242,14 +332,14 @@ class _Owners:
     """Which measured function encloses a byte offset (functions do not overlap)."""
 
     def __init__(self, slots: list[FunctionSlot]) -> None:
-        self._slots = slots
+        self.slots = slots
         self._starts = [slot.start for slot in slots]
 
     def at(self, offset: int) -> FunctionSlot | None:
         """The function whose definition holds byte ``offset``, if any."""
         index = bisect.bisect_right(self._starts, offset) - 1
-        if index >= 0 and offset < self._slots[index].end:
-            return self._slots[index]
+        if index >= 0 and offset < self.slots[index].end:
+            return self.slots[index]
         return None
 
     def claim(self, offset: int) -> str | None:
@@ -291,8 +381,11 @@ def _functions(nodes: list[Node], data: bytes, scopes: Scopes) -> list[FunctionS
     return slots
 
 
-def _decisions(found: dict[str, list[Node]], owner: _Owners) -> None:
-    """Add each decision token inside a function body to that function."""
+def _decisions(
+    found: dict[str, list[Node]], owner: _Owners, directives_read: list[tuple[int, str, int]]
+) -> None:
+    """Add each decision token inside a function body to that function, and each decision
+    of ``directives_read`` ((offset, kind, line) of directives a spelling blanked)."""
     not_decisions = {node.id for node in found.get("nodecision", [])}
     directives = sorted((node.start_byte, node.end_byte) for node in found.get("directive", []))
     directive_starts = [start for start, _ in directives]
@@ -307,6 +400,12 @@ def _decisions(found: dict[str, list[Node]], owner: _Owners) -> None:
         if slot.body_start <= offset < slot.body_end:
             kind = c_tables.DECISIONS[node.type]
             slot.decisions.append(Decision(kind, node.start_point.row + 1))
+    for offset, kind, line in directives_read:
+        slot = owner.at(offset)
+        if slot is not None and slot.body_start <= offset < slot.body_end:
+            slot.decisions.append(Decision(kind, line))
+    for slot in owner.slots:
+        slot.decisions.sort(key=lambda decision: decision.line)
 
 
 def _templates(found: dict[str, list[Node]]) -> dict[int, tuple[int, int]]:

@@ -19,10 +19,12 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-_MACRO = rb"(?:[A-Z_][A-Z0-9_]*[A-Z][A-Z0-9_]*)"
-_ARGS = rb"(?:\s*\((?:[^()]|\((?:[^()]|\([^()]*\))*\))*\))"
-_NAME = rb"[A-Za-z_]\w*"
-_QUALIFIERS = rb"(?:\s*(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*"
+# Every repetition is possessive or atomic: a run of macros (``DECLARE(A) DECLARE(B) ...``)
+# that fails to match must fail in one pass, never by trying each way to split it.
+_MACRO = rb"(?=[0-9_]*+[A-Z])[A-Z_][A-Z0-9_]*+"
+_ARGS = rb"(?>\s*+\((?:[^()]++|\((?:[^()]++|\([^()]*+\))*+\))*+\))"
+_NAME = rb"[A-Za-z_]\w*+"
+_QUALIFIERS = rb"(?:\s*+(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*+"
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,8 +60,9 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
         # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT
         (re.compile(rb"(?m)^[ \t]*(" + macro + rb")[ \t]*(?://[^\n]*)?$"), False, False),
         # void Lock() EXCLUSIVE_LOCKS_REQUIRED(mu_);   int f() const OVERRIDE {
-        (re.compile(rb"\)" + _QUALIFIERS + rb"\s*((?:" + macro + _ARGS + rb"?\s*)+)(?=;|\{|=[^=]"
-                    + rb"|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"), True, False),
+        (re.compile(rb"\)" + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS + rb"?+\s*+)++)"
+                    + rb"(?=;|\{|=[^=]|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"),
+         True, False),
         # a macro call alone on its line, not heading a body: RAPIDJSON_DIAG_OFF(effc++)
         (re.compile(rb"(?m)^[ \t]*(" + macro + _ARGS + rb")[ \t]*(?://[^\n]*)?$(?!\s*[{:,.=])"),
          True, False),
@@ -104,6 +107,11 @@ class _Ranges:
         return index >= 0 and offset < self._spans[index][1]
 
 
+def literal_spans(data: bytes) -> _Ranges:
+    """The byte ranges of ``data``'s string and character literals and comments."""
+    return _Ranges([found.span() for found in _LITERALS.finditer(data)])
+
+
 def blank_macros(
     data: bytes,
     bodies: Iterable[tuple[int, int]] = (),
@@ -125,7 +133,7 @@ def blank_macros(
     if not hits:
         return data
     in_body = _Ranges(list(bodies))
-    literal = _Ranges([found.span() for found in _LITERALS.finditer(data)])
+    literal = literal_spans(data)
     out = bytearray(data)
     for number, found, between in hits:
         start, end = found.span(1)

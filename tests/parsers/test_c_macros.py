@@ -168,3 +168,167 @@ def test_a_listed_attribute_macro_need_not_be_in_capitals() -> None:
 def test_no_lines_are_lost_to_the_blanking() -> None:
     facts = facts_of("class FOO_EXPORT A {\n  int f() {\n    return 1;\n  }\n};\n", "cpp")
     assert facts.functions[0].span == Span(2, 4)
+
+
+def test_a_run_of_macro_calls_after_a_parenthesis_is_read_in_one_pass() -> None:
+    # each `DECLARE(X)` could be split between the macro rule's repetitions in many ways:
+    # a backtracking pattern took minutes on forty of them (sentencepiece's util.h)
+    source = "int f(int a)\n" + "".join(f"DECLARE_ERROR(Code{i})\n" for i in range(60))
+    facts = facts_of(source + "int g(int a) { if (a) return 1; return 2; }\n", "cpp")
+    assert complexities(facts)["g"] == 2
+
+
+# --- 2. an #if that splits a statement or an expression -------------------------------------
+
+LANGUAGES = pytest.mark.parametrize("language", ["c", "cpp"])
+
+
+@LANGUAGES
+def test_an_if_spelled_twice_counts_every_branch_as_written(language: str) -> None:
+    facts = facts_of(
+        """
+        int f(int sock) {
+        #ifdef _WIN32
+          if (sock == INVALID_SOCKET)
+        #else
+          if (sock < 0)
+        #endif
+          { return -1; }
+          return 0;
+        }
+        int g(int a) { if (a) return 1; return 2; }
+        """,
+        language,
+    )
+    # #ifdef, and both spellings of the if: every token as written, once (as lizard)
+    assert complexities(facts) == {"f": 4, "g": 2}
+    assert spans(facts) == {"f": (2, 10), "g": (11, 11)}
+    assert [s.kind for s in facts.statements].count("if") == 3
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_an_else_between_an_if_and_its_condition_is_read_one_branch_at_a_time(
+    language: str,
+) -> None:
+    facts = facts_of(
+        """
+        int f(int a) {
+          if (
+        #ifdef X
+              a > 1 && a < 9
+        #else
+              a > 2
+        #endif
+             ) { return 1; }
+          return 0;
+        }
+        int g(int a) { if (a) return 1; return 2; }
+        """,
+        language,
+    )
+    assert spans(facts) == {"f": (2, 11), "g": (12, 12)}
+    assert complexities(facts)["g"] == 2
+    # the two spellings of the condition do not parse together: the first branch is read
+    assert [d.kind for d in facts.functions[0].decisions] == ["if", "#ifdef", "&&"]
+    assert not lost(facts)
+
+
+def test_an_if_inside_an_initializer_list_keeps_the_constructor() -> None:
+    facts = facts_of(
+        """
+        Foo::Foo(int a)
+          : a_(a),
+        #ifdef X
+            b_(1),
+        #else
+            b_(2),
+        #endif
+            c_(3) {
+          if (a) x();
+        }
+        int g(int a) { if (a) return 1; return 2; }
+        """,
+        "cpp",
+    )
+    assert spans(facts) == {"Foo::Foo": (2, 11), "g": (12, 12)}
+    assert complexities(facts) == {"Foo::Foo": 2, "g": 2}  # the #ifdef is not in the body
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_an_else_if_that_exists_in_one_branch_only(language: str) -> None:
+    facts = facts_of(
+        """
+        int f(int a) {
+          if (a == 1) {
+            return 1;
+        #ifdef X
+          } else if (a == 2) {
+            return 2;
+        #endif
+          } else {
+            return 3;
+          }
+        }
+        int g(int a) { if (a) return 1; return 2; }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"f": 4, "g": 2}
+    assert spans(facts)["g"] == (13, 13)
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_one_broken_spot_no_longer_takes_the_rest_of_the_file(language: str) -> None:
+    later = "".join(f"int g{i}(int a) {{ if (a > {i}) return 1; return 0; }}\n" for i in range(20))
+    facts = facts_of(
+        """
+        int f(int a) {
+        #if defined(A) && defined(B) /* both */ \\
+            && !defined(C)
+          while (a-- > 0 &&
+        #else
+          while (a-- > 1 &&
+        #endif
+                 ready()) { step(); }
+          return a;
+        }
+        """
+        + later,
+        language,
+    )
+    assert len(facts.functions) == 21
+    # the #if is one decision; the && in its condition is not (lizard reads a directive as
+    # one token). The two spellings of the loop's head do not parse together, so the
+    # region is read with its first branch only: while, && (lizard, reading tokens, has 6)
+    assert complexities(facts)["f"] == 4
+    assert [d.line for d in facts.functions[0].decisions] == [3, 5, 5]
+    assert all(complexities(facts)[f"g{i}"] == 2 for i in range(20))
+
+
+def test_a_directive_that_guards_a_whole_file_is_not_read_as_one_branch() -> None:
+    # Cython's files: `#ifndef Py_PYTHON_H / #error ... / #else / <the whole file> / #endif`.
+    # A spelling that keeps the first branch reads cleanly but sets the file aside.
+    facts = facts_of(
+        """
+        #ifndef Py_PYTHON_H
+            #error Python headers needed to compile C extensions.
+        #else
+        static int f(int a) {
+          if (
+        #ifdef X
+            a
+        #else
+            !a
+        #endif
+          ) return 1;
+          return 0;
+        }
+        static int g(int a) { if (a) return 1; return 2; }
+        #endif
+        """,
+        "c",
+    )
+    assert set(complexities(facts)) == {"f", "g"}

@@ -1,0 +1,156 @@
+"""Preprocessor conditionals read without their directives, where the file as written does
+not parse (docs/metrics.md, "Macros and #if").
+
+tree-sitter parses the text before preprocessing and wants every ``#if`` branch to hold
+whole declarations or statements. Real code splits one statement between branches
+(``#ifdef _WIN32 / if (s == INVALID_SOCKET) / #else / if (s < 0) / #endif / { ... }``), and
+then everything from there to the end of the file may become one ERROR node. This module
+builds *spellings* of a file: the same bytes with every conditional directive line
+overwritten by spaces (every offset and line stays), and either every branch kept, as
+written (``ALL``), or in each ``#if`` group only its k-th branch kept (the others blanked
+too). c_family.py parses the spellings and, per damaged region of the file as written,
+takes the spelling that reads that region with the least damage.
+
+The directives a spelling blanks still count where lizard counts them (``#if``, ``#ifdef``,
+``#elif``... in a function body are decisions): ``Conditionals.decisions`` gives them from
+the text.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from archmetrics.parsers.c_family_macros import literal_spans
+
+_DIRECTIVE = re.compile(rb"(?m)^[ \t]*#[ \t]*(ifdef|ifndef|if|elifdef|elifndef|elif|else|endif)\b")
+_OPENS = frozenset({"if", "ifdef", "ifndef"})
+_MIDDLE = frozenset({"elif", "elifdef", "elifndef", "else"})
+DECIDING = frozenset({"if", "ifdef", "ifndef", "elif", "elifdef", "elifndef"})
+
+ALL = -1
+"""The spelling that keeps every branch as written and blanks only the directive lines."""
+
+
+@dataclass(frozen=True, slots=True)
+class Directive:
+    """A conditional directive line: ``start`` is its ``#``; ``end`` the end of its line and
+    continuation lines (comments on them are kept when it is blanked)."""
+
+    start: int
+    end: int
+    keyword: str
+    line: int  # 1-based
+
+
+@dataclass(frozen=True, slots=True)
+class Group:
+    """One ``#if`` ... ``#endif`` group: its directives in order, the last an ``#endif``.
+    Branch i is the text between directive i and directive i + 1."""
+
+    directives: tuple[Directive, ...]
+
+    @property
+    def branches(self) -> int:
+        return len(self.directives) - 1
+
+
+_COMMENT = re.compile(rb"//[^\n]*|/\*(?:[^*]|\*(?!/))*\*/")
+
+
+def _directive_end(data: bytes, start: int) -> int:
+    """Where the directive at ``start`` ends: the end of its line and continuation lines,
+    or the start of a block comment that runs past them."""
+    end = start
+    while True:
+        newline = data.find(b"\n", end)
+        if newline < 0:
+            end = len(data)
+            break
+        opened = data.rfind(b"/*", start, newline)
+        if opened >= 0 and data.find(b"*/", opened + 2, newline) < 0:
+            return opened
+        end = newline
+        if not data[start:newline].rstrip(b"\r").endswith(b"\\"):
+            break
+        end = newline + 1
+    return end
+
+
+class Conditionals:
+    """The ``#if`` groups of a file, outside comments and string literals. Groups that are
+    never closed, and stray ``#else``/``#endif`` lines, are left as they are."""
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+        literals = literal_spans(data)
+        groups: list[Group] = []
+        stack: list[list[Directive]] = []
+        line, last = 1, 0
+        for found in _DIRECTIVE.finditer(data):
+            start = found.start()
+            if start in literals:
+                continue
+            line += data.count(b"\n", last, start)
+            last = start
+            hash_at = data.index(b"#", start)
+            keyword = found.group(1).decode()
+            directive = Directive(hash_at, _directive_end(data, hash_at), keyword, line)
+            if keyword in _OPENS:
+                stack.append([directive])
+            elif stack and keyword in _MIDDLE:
+                stack[-1].append(directive)
+            elif stack and keyword == "endif":
+                opened = stack.pop()
+                opened.append(directive)
+                groups.append(Group(tuple(opened)))
+        self.groups = tuple(sorted(groups, key=lambda g: g.directives[0].start))
+
+    @property
+    def most_branches(self) -> int:
+        return max((group.branches for group in self.groups), default=0)
+
+    def spelling(self, branch: int) -> tuple[bytes, list[tuple[int, int]]]:
+        """The file with every directive line blanked and, unless ``branch`` is ``ALL``, in
+        each group every branch but the ``branch``-th blanked (a group with fewer keeps its
+        last); and the byte ranges of the branches blanked."""
+        out = bytearray(self.data)
+        set_aside: list[tuple[int, int]] = []
+        for group in self.groups:
+            directives = group.directives
+            for directive in directives:
+                _blank_code(out, directive.start, directive.end)
+            if branch == ALL:
+                continue
+            keep = min(branch, group.branches - 1)
+            for index in range(group.branches):
+                if index != keep:
+                    start, end = directives[index].end, directives[index + 1].start
+                    _blank(out, start, end)
+                    set_aside.append((start, end))
+        return bytes(out), set_aside
+
+    def decisions(self) -> list[tuple[int, str, int]]:
+        """(byte offset, decision kind, line) of each directive that is a decision."""
+        return [
+            (directive.start, "#" + directive.keyword, directive.line)
+            for group in self.groups
+            for directive in group.directives
+            if directive.keyword in DECIDING
+        ]
+
+
+_KEEP_NEWLINES = bytes(b if b == 10 else 32 for b in range(256))
+
+
+def _blank(out: bytearray, start: int, end: int) -> None:
+    out[start:end] = bytes(out[start:end]).translate(_KEEP_NEWLINES)
+
+
+def _blank_code(out: bytearray, start: int, end: int) -> None:
+    """Blank ``[start, end)`` but the comments in it."""
+    at = start
+    for comment in _COMMENT.finditer(out, start, end):
+        _blank(out, at, comment.start())
+        at = comment.end()
+    _blank(out, at, end)

@@ -1,0 +1,183 @@
+"""Which parse reads each damaged region of a C/C++ file (docs/metrics.md, "Macros and #if").
+
+The file as written (``base``) has ERROR regions; other spellings of the same bytes
+(c_family_branches.py) may read them cleanly. A region is grown until it holds whole
+syntax on both sides: every declaration, statement, body, class or namespace of either
+parse that overlaps it either lies inside it or encloses it in *both* parses with the same
+extent and kind (the function around a broken ``if`` is the same function in both). Inside
+the region, every capture comes from the spelling that reads it with the least damage;
+outside, from the base. So nothing is counted twice and nothing outside a damaged region
+changes.
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+
+from tree_sitter import Node
+
+#: The captures that give a parse its shape: a region never cuts one of them in two.
+STRUCTURE = ("stmt", "class", "namespace", "body", "error")
+
+Damage = tuple[int, int]  # bytes inside ERROR nodes, tokens the parser invented
+
+
+class Layout:
+    """One parse's structural nodes, sorted, with each one's innermost enclosing node."""
+
+    def __init__(
+        self,
+        found: dict[str, list[Node]],
+        data: bytes,
+        set_aside: Sequence[tuple[int, int]] = (),
+    ) -> None:
+        """``data``: the bytes as written; ``set_aside``: byte ranges this parse did not
+        read (#if branches its spelling blanked)."""
+        self.data = data
+        nodes = sorted(
+            {
+                (node.start_byte, -node.end_byte, node.type)
+                for name in STRUCTURE
+                for node in found.get(name, [])
+            }
+        )
+        self.starts = [start for start, _, _ in nodes]
+        self.ends = [-end for _, end, _ in nodes]
+        self.kinds = [kind for _, _, kind in nodes]
+        self.shapes = {(start, -end, kind) for start, end, kind in nodes}
+        self.parents: list[int] = []
+        open_nodes: list[int] = []
+        for index, start in enumerate(self.starts):
+            while open_nodes and self.ends[open_nodes[-1]] <= start:
+                open_nodes.pop()
+            self.parents.append(open_nodes[-1] if open_nodes else -1)
+            open_nodes.append(index)
+        errors: list[tuple[int, int]] = []
+        for node in sorted(found.get("error", []), key=lambda n: n.start_byte):
+            if not errors or node.start_byte >= errors[-1][1]:
+                errors.append((node.start_byte, node.end_byte))
+        self.errors = errors
+        self.missing = sorted(node.start_byte for node in found.get("missing", []))
+        self.broken = _union(
+            [_lines(data, s, e) for s, e in errors + [(m, m) for m in self.missing]]
+        )
+        self.set_aside = sorted(set_aside)
+        self.damaged = _union(errors + [_around(node) for node in found.get("missing", [])])
+
+    def crossing(self, start: int, end: int) -> Iterator[tuple[int, int, str]]:
+        """The nodes that overlap ``[start, end)`` without lying inside it."""
+        index = bisect.bisect_left(self.starts, start) - 1
+        while index >= 0:  # the nodes around `start` are on one chain of parents
+            if self.ends[index] > start:
+                yield self.starts[index], self.ends[index], self.kinds[index]
+            index = self.parents[index]
+        first = bisect.bisect_left(self.starts, start)
+        for index in range(first, bisect.bisect_left(self.starts, end)):
+            if self.ends[index] > end:
+                yield self.starts[index], self.ends[index], self.kinds[index]
+
+    def damage(self, start: int, end: int) -> Damage:
+        """The damage of this parse inside ``[start, end)``: the bytes of the lines it broke
+        (an ERROR node, a token it had to invent), and the code (not the white space) of
+        the branches its spelling set aside; then the number of tokens it invented."""
+        lost = _overlap(self.broken, start, end)
+        for s, e in self.set_aside[_first(self.set_aside, start) :]:
+            if s >= end:
+                break
+            lost += len(self.data[max(start, s) : min(end, e)].translate(None, b" \t\r\n"))
+        invented = bisect.bisect_right(self.missing, end) - bisect.bisect_left(self.missing, start)
+        return lost, invented
+
+
+def _first(ranges: list[tuple[int, int]], start: int) -> int:
+    """The index of the first of sorted, disjoint ``ranges`` that may overlap ``start``."""
+    return max(0, bisect.bisect_right(ranges, (start, start)) - 1)
+
+
+def _overlap(ranges: list[tuple[int, int]], start: int, end: int) -> int:
+    """How many bytes of sorted, disjoint ``ranges`` lie in ``[start, end)``."""
+    total = 0
+    for s, e in ranges[_first(ranges, start) :]:
+        if s >= end:
+            break
+        total += max(0, min(end, e) - max(start, s))
+    return total
+
+
+def _lines(data: bytes, start: int, end: int) -> tuple[int, int]:
+    """``[start, end)`` grown to whole lines."""
+    after = data.find(b"\n", end)
+    return data.rfind(b"\n", 0, start) + 1, len(data) if after < 0 else after
+
+
+def _union(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """Sorted ranges, those that overlap or touch joined."""
+    joined: list[tuple[int, int]] = []
+    for start, end in sorted(ranges):
+        if joined and start <= joined[-1][1]:
+            joined[-1] = (joined[-1][0], max(end, joined[-1][1]))
+        else:
+            joined.append((start, end))
+    return joined
+
+
+def _around(missing: Node) -> tuple[int, int]:
+    """The region a token the parser invented damages: the node it completes."""
+    parent = missing.parent  # one walk down from the root: there are few such tokens
+    node = parent if parent is not None else missing
+    return node.start_byte, node.end_byte
+
+
+def grow(start: int, end: int, base: Layout, other: Layout) -> tuple[int, int]:
+    """``[start, end)`` grown until no node of either parse crosses its edges, except nodes
+    that enclose it in both parses alike."""
+    while True:
+        grown = (start, end)
+        for mine, theirs in ((base, other), (other, base)):
+            for s, e, kind in list(mine.crossing(start, end)):
+                if s <= start and end <= e and (s, e, kind) in theirs.shapes:
+                    continue
+                start, end = min(start, s), max(end, e)
+        if (start, end) == grown:
+            return start, end
+
+
+@dataclass(frozen=True, slots=True)
+class Choice:
+    """Region ``[start, end)`` is read by spelling number ``reader``."""
+
+    start: int
+    end: int
+    reader: int
+
+
+def choose(base: Layout, others: Sequence[Layout]) -> list[Choice]:
+    """For each damaged region of ``base``, the spelling (an index into ``others``) that reads
+    it with the least damage, if one reads it with less than the base; regions do not
+    overlap. Ties go to the earlier spelling."""
+    choices: list[Choice] = []
+    pending = list(base.damaged)
+    while pending:
+        start, end = pending.pop(0)
+        best: Choice | None = None
+        best_damage: Damage | None = None
+        for reader, other in enumerate(others):
+            s, e = grow(start, end, base, other)
+            damage = other.damage(s, e)
+            if damage < base.damage(s, e) and (best_damage is None or damage < best_damage):
+                best, best_damage = Choice(s, e, reader), damage
+        if best is None:
+            continue
+        overlapping = [c for c in choices if c.start < best.end and best.start < c.end]
+        if overlapping:  # two regions grew into one: choose again for their union
+            choices = [c for c in choices if c not in overlapping]
+            union = (min([best.start] + [c.start for c in overlapping]),
+                     max([best.end] + [c.end for c in overlapping]))  # fmt: skip
+            if union != (best.start, best.end) or len(overlapping) > 1:
+                pending.insert(0, union)
+                continue
+        choices.append(best)
+        pending = [(s, e) for s, e in pending if not (best.start <= s and e <= best.end)]
+    return sorted(choices, key=lambda c: c.start)
