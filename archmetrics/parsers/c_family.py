@@ -25,6 +25,7 @@ from archmetrics.facts import (
 from archmetrics.parsers import c_tables
 from archmetrics.parsers.c_family_branches import ALL, Conditionals
 from archmetrics.parsers.c_family_calls import CallSites
+from archmetrics.parsers.c_family_definitions import Definition, definitions
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
     Grammar,
@@ -32,12 +33,11 @@ from archmetrics.parsers.c_family_grammar import (
     grammar,
     syntax_tree,
 )
-from archmetrics.parsers.c_family_macros import blank_macros
+from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
 from archmetrics.parsers.c_family_names import (
     Scopes,
     function_name,
     in_order,
-    span,
     typedef_names,
 )
 from archmetrics.parsers.c_family_outline import classes, includes, warnings
@@ -179,7 +179,8 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
     if reading.root.has_error:
         reading = _recover(built, reading, limits)
     composite = _branches(built, reading, limits) if reading.root.has_error else None
-    return _facts(path, language, built, composite or Composite.of(reading), data)
+    reading_used = composite or Composite.of(reading)
+    return _facts(path, language, built, reading_used, data, limits.c_macros)
 
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
@@ -257,13 +258,21 @@ def _merge(
 
 
 def _facts(
-    path: str, language: Language, built: Grammar, reading: Composite, data: bytes
+    path: str,
+    language: Language,
+    built: Grammar,
+    reading: Composite,
+    data: bytes,
+    macros: MacroNames,
 ) -> FileFacts:
     """The facts of ``reading``'s captures, with every text taken from ``data`` as written."""
     root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
-    slots = _functions(found.get("stmt", []), data, scopes)
+    made, explained = definitions(
+        in_order(found.get("stmt", [])), found.get("missing", []), data, macros.function
+    )
+    slots = _functions(made, data, scopes)
     owner = _Owners(slots)
     skip = {node.id for node in found.get("skip", [])}
     guard = include_guard(root, data)
@@ -289,7 +298,7 @@ def _facts(
         dependencies=includes(nodes, data),
         call_sites=CallSites(found.get("call", []), data).sites(owner.name),
         sloc=sloc(clean),
-        warnings=warnings(path, found, data),
+        warnings=warnings(path, {**found, "expected": found.get("expected", []) + explained}, data),
     )
 
 
@@ -355,29 +364,32 @@ class _Owners:
         return slot.qualified if slot is not None else None
 
 
-def _functions(nodes: list[Node], data: bytes, scopes: Scopes) -> list[FunctionSlot]:
+def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> list[FunctionSlot]:
     """Function definitions with a body that are not inside another function (as lizard)."""
     slots: list[FunctionSlot] = []
     last_end = -1
-    definitions = in_order(node for node in nodes if node.type == c_tables.FUNCTION)
-    prefixes = scopes.prefixes(definitions)
-    for node in definitions:
-        body = node.child_by_field_name("body")
-        if body is None or node.start_byte < last_end:
+    prefixes = scopes.prefixes([definition.node for definition in definitions])
+    for definition in definitions:
+        node, body = definition.node, definition.body
+        if node.start_byte < last_end:
             continue
-        name, qualified = function_name(node, data, prefixes[node.id])
+        prefix = prefixes[node.id]
+        if definition.macro is None:
+            name, qualified = function_name(node, data, prefix)
+        else:
+            name, qualified = definition.macro, f"{prefix}::{definition.macro}".lstrip(":")
         slots.append(
             FunctionSlot(
                 name,
                 qualified,
-                span(node),
-                node.start_byte,
-                node.end_byte,
+                definition.span,
+                definition.start,
+                definition.end,
                 body.start_byte,
                 body.end_byte,
             )
         )
-        last_end = node.end_byte
+        last_end = definition.end
     return slots
 
 

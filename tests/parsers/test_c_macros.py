@@ -332,3 +332,64 @@ def test_a_directive_that_guards_a_whole_file_is_not_read_as_one_branch() -> Non
         "c",
     )
     assert set(complexities(facts)) == {"f", "g"}
+
+
+# --- 4. a macro that defines a function -----------------------------------------------------
+
+
+@LANGUAGES
+def test_a_body_after_a_call_like_head_at_file_scope_is_a_function(language: str) -> None:
+    facts = facts_of(
+        """
+        TEST(Suite, Name) {
+          if (a) b();
+        }
+        MATCHER(IsEven, "") { return (arg % 2) == 0; }
+        int g(int a) { if (a) return 1; return 2; }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"TEST": 2, "MATCHER": 1, "g": 2}
+    assert spans(facts)["TEST"] == (2, 4)
+    assert not lost(facts)  # the `;` tree-sitter invented is no loss
+
+
+def test_a_macro_made_function_inside_a_namespace_is_qualified() -> None:
+    facts = facts_of("namespace t {\nTEST_F(Fixture, Case) { while (x) y(); }\n}\n", "cpp")
+    assert complexities(facts) == {"t::TEST_F": 2}
+
+
+@LANGUAGES
+def test_a_macro_loop_inside_a_function_is_not_a_function(language: str) -> None:
+    facts = facts_of(
+        "void f(void) {\n  FOR_EACH(item, list) { if (item) use(item); }\n}\n", language
+    )
+    assert complexities(facts) == {"f": 2}
+
+
+@LANGUAGES
+def test_a_call_missing_its_semicolon_before_a_block_in_a_function_stays_a_statement(
+    language: str,
+) -> None:
+    facts = facts_of("int x = f(1)\n{ g(); }\nint h(void) { return 0; }\n", language)
+    assert "f" not in complexities(facts)
+
+
+# --- 5. an empty body followed by `;` -------------------------------------------------------
+
+
+def test_an_empty_method_body_followed_by_a_semicolon_is_a_method() -> None:
+    facts = facts_of(
+        """
+        class A {
+          virtual void f() {};
+          virtual int g() { if (a) return 1; return 0; };
+          int h() const {}
+          int v = {};
+          int w{};
+        };
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {"A::f": 1, "A::g": 2, "A::h": 1}
+    assert spans(facts)["A::f"] == (3, 3)
