@@ -6,6 +6,7 @@ over it. An unknown key or a value of the wrong type is an error naming the file
 
 from __future__ import annotations
 
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -78,6 +79,38 @@ def _limits(table: Mapping[str, Any], where: str) -> LimitSettings:
 
 
 @dataclass(frozen=True, slots=True)
+class MacroSettings:
+    """C/C++ macros the parsers cannot tell from their place and spelling (docs/metrics.md,
+    "Macros and #if"): ``attribute`` macros expand to nothing a metric counts (export and
+    annotation macros, e.g. a lower-case ``my_export``); ``function`` macros head a
+    function definition (``TEST(Suite, Name) { ... }``)."""
+
+    attribute: tuple[str, ...] = ()
+    function: tuple[str, ...] = ()
+
+
+MAX_MACROS = 10_000
+_MACRO_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,199}")
+
+
+def _macros(table: Mapping[str, Any], where: str) -> MacroSettings:
+    _check_keys(table, {"attribute", "function"}, where)
+    values: dict[str, tuple[str, ...]] = {}
+    for key, value in table.items():
+        here = f"{where}.{key}"
+        names = _strings(value, here)
+        if len(names) > MAX_MACROS:
+            raise ConfigError(f"{here}: more than {MAX_MACROS:,} names")
+        for name in names:
+            if not _MACRO_NAME.fullmatch(name):
+                raise ConfigError(
+                    f"{here}: {name[:40]!r} is not a C identifier (at most 200 characters)"
+                )
+        values[key] = tuple(sorted(set(names)))
+    return MacroSettings(**values)
+
+
+@dataclass(frozen=True, slots=True)
 class Settings:
     """Everything configurable, with its defaults. ``source`` names the file it came from."""
 
@@ -92,6 +125,7 @@ class Settings:
     cache: bool = True
     jobs: int = 0  # 0: one worker per core
     limits: LimitSettings = field(default_factory=LimitSettings)
+    macros: MacroSettings = field(default_factory=MacroSettings)
 
 
 def _strings(value: Any, where: str) -> tuple[str, ...]:
@@ -167,6 +201,7 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
         "cache",
         "jobs",
         "limits",
+        "macros",
     }
     _check_keys(table, known, source)
     values: dict[str, Any] = {"source": source}
@@ -190,6 +225,8 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
             values["coupling"] = _coupling(_table(value, here), here)
         elif key == "limits":
             values["limits"] = _limits(_table(value, here), here)
+        elif key == "macros":
+            values["macros"] = _macros(_table(value, here), here)
         elif key == "cache-path":
             if not isinstance(value, str):
                 raise ConfigError(f"{here}: expected a path")

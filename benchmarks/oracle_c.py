@@ -6,7 +6,7 @@ Sdists from PyPI (pinned below) are fetched into ``DIR`` (default ``.cache/corpu
 PyPI's simple index and unpacked. For every C/C++ file both tools read, functions are
 matched by (file, last line), as tests/parsers/test_c_oracle.py does. Per corpus it prints:
 the files, lizard's functions, how many of them we found, how many of the found ones have
-the same v_g, and the files whose v_g sum falls below 0.9x lizard's while our parser reports
+the same v_g (the others by the class of docs/metrics.md that explains them), and the files whose v_g sum falls below 0.9x lizard's while our parser reports
 a lost region. ``--show`` prints that many examples of each kind of difference.
 """
 
@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 from archmetrics.facts import Language  # noqa: E402
 from archmetrics.parsers import c_family  # noqa: E402
+from tests.parsers.test_c_oracle import _disagreement_class  # noqa: E402
 
 # name -> (pip requirement, folders inside the unpacked sdist that hold the C/C++ we read)
 CORPORA: dict[str, tuple[str, tuple[str, ...]]] = {
@@ -78,6 +79,7 @@ class Tally:
     low_files: int = 0
     missing: list[str] = field(default_factory=list)
     unequal: list[str] = field(default_factory=list)
+    explained: dict[str, int] = field(default_factory=dict)
     low: list[str] = field(default_factory=list)
     extra: int = 0
 
@@ -92,6 +94,7 @@ def compare_file(item: tuple[str, str]) -> Tally:
     theirs = lizard.analyze_file.analyze_source_code(path, source).function_list
     ours = {f.span.end: f for f in facts.functions}
     tally = Tally(files=1, lizard=len(theirs))
+    lines = source.splitlines()
     for other in theirs:
         mine = ours.get(other.end_line)
         where = f"{shown}:{other.start_line}-{other.end_line} {other.long_name[:80]}"
@@ -101,10 +104,12 @@ def compare_file(item: tuple[str, str]) -> Tally:
         tally.found += 1
         if mine.complexity == other.cyclomatic_complexity:
             tally.equal += 1
-        else:
-            tally.unequal.append(
-                f"{where}: ours {mine.complexity}, lizard {other.cyclomatic_complexity}"
-            )
+            continue
+        kind = _disagreement_class(lines, mine, other.cyclomatic_complexity)
+        tally.explained[kind] = tally.explained.get(kind, 0) + 1
+        tally.unequal.append(
+            f"{where}: ours {mine.complexity}, lizard {other.cyclomatic_complexity} [{kind[:2]}]"
+        )
     tally.extra = len(ours) - tally.found
     lizard_vg = sum(f.cyclomatic_complexity for f in theirs)
     our_vg = sum(f.complexity for f in facts.functions)
@@ -124,6 +129,8 @@ def merge(tallies: list[Tally]) -> Tally:
             setattr(total, name, getattr(total, name) + getattr(t, name))
         total.missing += t.missing
         total.unequal += t.unequal
+        for kind, count in t.explained.items():
+            total.explained[kind] = total.explained.get(kind, 0) + count
         total.low += t.low
     return total
 
@@ -155,6 +162,8 @@ def main() -> None:
                   f"{total.found} ({total.found / max(1, total.lizard):.2%}), equal v_g "
                   f"{total.equal} ({total.equal / max(1, total.found):.2%}), files below "
                   f"0.9x v_g {total.low_files}, ours only {total.extra}", flush=True)  # fmt: skip
+            for kind, count in sorted(total.explained.items(), key=lambda item: -item[1]):
+                print(f"  v_g differs, class {kind}: {count}")
             for title, examples in (("missing", total.missing), ("unequal", total.unequal),
                                     ("low", total.low)):  # fmt: skip
                 for example in examples[: args.show]:

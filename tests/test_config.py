@@ -46,6 +46,10 @@ def test_pyproject_without_table_gives_defaults(tmp_path: Path) -> None:
         ("[locations]\nnewer = []\n", "unknown key 'newer'"),
         ("jobs = -1\n", "jobs: expected a non-negative integer"),
         ("exclude = [\n", "not valid TOML"),
+        ("[macros]\nexport = []\n", "unknown key 'export'"),
+        ('[macros]\nattribute = "A"\n', "macros.attribute: expected a list of strings"),
+        ('[macros]\nfunction = ["TEST(x)"]\n', "'TEST\\(x\\)' is not a C identifier"),
+        ('[macros]\nattribute = ["' + "A" * 201 + '"]\n', "at most 200 characters"),
     ],
 )
 def test_errors_name_file_and_key(tmp_path: Path, text: str, message: str) -> None:
@@ -53,3 +57,12 @@ def test_errors_name_file_and_key(tmp_path: Path, text: str, message: str) -> No
     with pytest.raises(ConfigError, match=message) as error:
         load_settings(tmp_path)
     assert "archmetrics.toml" in str(error.value)
+
+
+def test_macros_are_read_sorted_without_repeats(tmp_path: Path) -> None:
+    (tmp_path / "archmetrics.toml").write_text(
+        '[macros]\nattribute = ["my_export", "B_API", "my_export"]\nfunction = ["TEST"]\n'
+    )
+    settings = load_settings(tmp_path)
+    assert settings.macros.attribute == ("B_API", "my_export")
+    assert settings.macros.function == ("TEST",)

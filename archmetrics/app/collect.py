@@ -8,9 +8,10 @@ from dataclasses import dataclass
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.workers import Parsed, Task, WorkerLimits, parse_in_workers
-from archmetrics.config import LimitSettings
+from archmetrics.config import LimitSettings, MacroSettings
 from archmetrics.facts import FileFacts, ParseWarning, Severity
 from archmetrics.parsers import LanguageTable, ParseLimits
+from archmetrics.parsers.c_family_macros import MacroNames
 from archmetrics.sources import Snapshot, SourceFile, codec
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import blob_hash
@@ -117,12 +118,14 @@ def parse_all(
     return tuple(f for f in results if f is not None)
 
 
-def worker_limits(settings: LimitSettings) -> WorkerLimits:
-    """The configured limits as the worker pool and the parsers take them."""
+def worker_limits(settings: LimitSettings, macros: MacroSettings) -> WorkerLimits:
+    """The configured limits as the worker pool and the parsers take them, with the C/C++
+    macros the configuration names (the parsers' one other setting)."""
     parser = ParseLimits(
         max_bytes=int(settings.file_mb * (1 << 20)),
         max_depth=settings.nesting,
         parse_seconds=settings.parse_seconds,
+        c_macros=MacroNames(macros.attribute, macros.function),
     )
     return WorkerLimits(settings.file_seconds, settings.worker_memory_mb << 20, parser)
 

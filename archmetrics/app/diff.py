@@ -96,7 +96,10 @@ def _parse_side(
 ) -> tuple[FileFacts, ...]:
     overrides = request.settings.languages
     selected = select(snapshot, LanguageTable.default(dict(overrides)))
-    jobs, limits = request.jobs or request.settings.jobs, worker_limits(request.settings.limits)
+    jobs, limits = (
+        request.jobs or request.settings.jobs,
+        worker_limits(request.settings.limits, request.settings.macros),
+    )
     return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
 
 

@@ -95,7 +95,7 @@ def run_scan(
     if not selected:
         raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
     jobs = request.jobs or request.settings.jobs
-    limits = worker_limits(request.settings.limits)
+    limits = worker_limits(request.settings.limits, request.settings.macros)
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
     metrics = tuple(file_metrics(f) for f in facts)
     return ScanReport(

@@ -11,7 +11,7 @@ from typing import NoReturn
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.config import LimitSettings, Settings, load_settings
+from archmetrics.config import LimitSettings, MacroSettings, Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.printable import one_line
 from archmetrics.sources.cache import FactsCache, choose_path
@@ -114,8 +114,9 @@ def cache_location(args: argparse.Namespace, settings: Settings) -> Path:
 
 
 def limits_salt(settings: Settings) -> str:
-    """The parser limits when they differ from the defaults (facts depend on them), and the
-    stack the parsers may use (their depth limits shrink on a small one)."""
+    """The parser limits when they differ from the defaults (facts depend on them), the
+    stack the parsers may use (their depth limits shrink on a small one), and the C/C++
+    macros the configuration names."""
     from archmetrics.parsers.limits import stack_bytes
 
     limits = settings.limits
@@ -123,8 +124,14 @@ def limits_salt(settings: Settings) -> str:
     defaults = LimitSettings()
     changed = parser != (defaults.file_mb, defaults.nesting, defaults.parse_seconds)
     stack = stack_bytes()
+    macros = settings.macros
+    listed = [repr((macros.attribute, macros.function))] if macros != MacroSettings() else []
     return " ".join(
-        [*(map(str, parser) if changed else []), *([str(stack)] if stack < 8 << 20 else [])]
+        [
+            *(map(str, parser) if changed else []),
+            *([str(stack)] if stack < 8 << 20 else []),
+            *listed,
+        ]
     )
 
 

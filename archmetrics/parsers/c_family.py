@@ -11,7 +11,7 @@ import bisect
 import re
 from dataclasses import dataclass, field
 
-from tree_sitter import Node, QueryCursor
+from tree_sitter import Node, QueryCursor, Tree
 
 from archmetrics.facts import (
     Decision,
@@ -103,14 +103,28 @@ class Reading:
     Texts are always read from the bytes as written: blanking keeps every offset."""
 
     data: bytes
-    root: Node
+    tree: Tree
     found: dict[str, list[Node]]
     damage: tuple[int, int]  # bytes inside outermost ERROR nodes, tokens the parser invented
 
+    @property
+    def root(self) -> Node:
+        return self.tree.root_node
+
     @classmethod
-    def of(cls, built: Grammar, data: bytes, limits: ParseLimits) -> Reading | str:
-        """The reading of ``data``, or why there is none (a limit)."""
-        tree = syntax_tree(built.parser, data, limits.parse_seconds)
+    def of(
+        cls,
+        built: Grammar,
+        data: bytes,
+        limits: ParseLimits,
+        like: Reading | None = None,
+        within: tuple[int, int] | None = None,
+    ) -> Reading | str:
+        """The reading of ``data``, or why there is none (a limit). ``like``: a reading of
+        the same file with other spans blanked, whose tree the parse reuses; ``within``:
+        only the captures that overlap these bytes are wanted."""
+        old = (like.tree, like.data) if like is not None else None
+        tree = syntax_tree(built.parser, data, limits.parse_seconds, old)
         if tree is None:
             return (
                 f"tree-sitter's parse took longer than {limits.parse_seconds:g} s and was cut"
@@ -124,8 +138,11 @@ class Reading:
                 if depth == limits.max_depth
                 else "tree-sitter's query cannot go deeper"
             )
-        found = QueryCursor(built.query).captures(root)
-        return cls(data, root, found, _damage(found))
+        cursor = QueryCursor(built.query)
+        if within is not None:
+            cursor.set_byte_range(*within)
+        found = cursor.captures(root)
+        return cls(data, tree, found, _damage(found))
 
     def standalone(self) -> list[Node]:
         """The type specifiers that are a statement of their own (``struct S { ... };``)."""
@@ -189,7 +206,7 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
     blanked = blank_macros(reading.data, reading.bodies(), limits.c_macros)
     if blanked == reading.data:
         return reading
-    second = Reading.of(built, blanked, limits)
+    second = Reading.of(built, blanked, limits, reading)
     if isinstance(second, str) or second.damage >= reading.damage:
         return reading
     return second
@@ -202,22 +219,67 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     if not conditionals.groups:
         return None
     base = Layout(reading.found, reading.data)
+    if not base.damaged:
+        return None
     readings: list[Reading] = []
     layouts: list[Layout] = []
+    found_in: list[list[tuple[int, str, int]]] = []  # the blanked directives' decisions
     choices: list[Choice] = []
-    for branch in [ALL, *range(min(conditionals.most_branches, BRANCH_SPELLINGS))]:
-        spelling, set_aside = conditionals.spelling(branch)
-        other = Reading.of(built, spelling, limits)
+    # only the groups near the damage are read otherwise, and only the captures there are
+    # taken, unless a region grows past that window: then the whole file is read again
+    groups = conditionals.near(_suspects(reading.data, base))
+    if not groups:
+        return None  # no #if near the damage: another spelling would read it alike
+    window: tuple[int, int] | None = _around(reading.data, base.damaged, _CONTEXT_LINES)
+    spellings = [ALL, *range(min(max(g.branches for g in groups), BRANCH_SPELLINGS))]
+    index = 0
+    while index < len(spellings):
+        spelling = conditionals.spelling(spellings[index], groups)
+        other = Reading.of(built, spelling.data, limits, reading, window)
+        index += 1
         if isinstance(other, str):
             continue
         readings.append(other)
-        layouts.append(Layout(other.found, reading.data, set_aside))
+        layouts.append(Layout(other.found, reading.data, spelling.set_aside))
+        found_in.append(spelling.decisions)
         choices = choose(base, layouts)
+        if window is not None and not all(
+            window[0] <= c.start and c.end <= window[1] for c in choices
+        ):
+            window, index, readings, layouts, found_in = None, 0, [], [], []
+            groups = conditionals.near(None)
+            continue
         if _all_read(base, layouts, choices):
             break
     if not choices:
         return None
-    return _merge(reading, readings, choices, conditionals)
+    return _merge(reading, readings, choices, found_in)
+
+
+_CONTEXT_LINES = 40  # lines either side of the damage whose captures a spelling takes
+_SUSPECT_LINES = 3  # an #if group this near a damaged region may be its cause
+
+
+def _suspects(data: bytes, base: Layout) -> list[tuple[int, int]]:
+    """Where an #if directive may have caused the damage: each damaged region of ``base``
+    with ``_SUSPECT_LINES`` lines either side, and the function definition around it."""
+    spans = []
+    for start, end in base.damaged:
+        spans.append(_around(data, [(start, end)], _SUSPECT_LINES))
+        spans.extend(
+            (s, e) for s, e, kind in base.crossing(start, end) if kind == c_tables.FUNCTION
+        )
+    return spans
+
+
+def _around(data: bytes, damaged: list[tuple[int, int]], lines: int) -> tuple[int, int]:
+    """The bytes from ``lines`` lines before the first damage to as many after the last."""
+    start, end = damaged[0][0], damaged[-1][1]
+    for _ in range(lines):
+        start = max(0, data.rfind(b"\n", 0, max(0, start - 1)))
+        found = data.find(b"\n", end + 1)
+        end = len(data) if found < 0 else found
+    return start, end
 
 
 def _all_read(base: Layout, layouts: list[Layout], choices: list[Choice]) -> bool:
@@ -231,7 +293,10 @@ def _all_read(base: Layout, layouts: list[Layout], choices: list[Choice]) -> boo
 
 
 def _merge(
-    base: Reading, readings: list[Reading], choices: list[Choice], conditionals: Conditionals
+    base: Reading,
+    readings: list[Reading],
+    choices: list[Choice],
+    directives: list[list[tuple[int, str, int]]],
 ) -> Composite:
     """``base``'s captures outside the chosen regions, the chosen readings' inside."""
     starts = [choice.start for choice in choices]
@@ -243,7 +308,6 @@ def _merge(
     found = {name: [n for n in nodes if outside(n)] for name, nodes in base.found.items()}
     standalone = [node for node in base.standalone() if outside(node)]
     decisions: list[tuple[int, str, int]] = []
-    directives = conditionals.decisions()
     for choice in choices:
         chosen = readings[choice.reader]
 
@@ -253,7 +317,8 @@ def _merge(
         for name, nodes in chosen.found.items():
             found.setdefault(name, []).extend(filter(inside, nodes))
         standalone.extend(filter(inside, chosen.standalone()))
-        decisions.extend(d for d in directives if choice.start <= d[0] < choice.end)
+        blanked = directives[choice.reader]
+        decisions.extend(d for d in blanked if choice.start <= d[0] < choice.end)
     return Composite(base.root, found, standalone, decisions)
 
 

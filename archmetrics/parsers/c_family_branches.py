@@ -12,12 +12,15 @@ too). c_family.py parses the spellings and, per damaged region of the file as wr
 takes the spelling that reads that region with the least damage.
 
 The directives a spelling blanks still count where lizard counts them (``#if``, ``#ifdef``,
-``#elif``... in a function body are decisions): ``Conditionals.decisions`` gives them from
-the text.
+``#elif``... in a function body are decisions): ``Spelling.decisions`` gives them from the
+text. Only the groups near the damage are blanked (``Conditionals.near``), so tree-sitter
+reparses only around it.
 """
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import re
 from dataclasses import dataclass
 
@@ -106,17 +109,27 @@ class Conditionals:
                 groups.append(Group(tuple(opened)))
         self.groups = tuple(sorted(groups, key=lambda g: g.directives[0].start))
 
-    @property
-    def most_branches(self) -> int:
-        return max((group.branches for group in self.groups), default=0)
+    def near(self, spans: list[tuple[int, int]] | None) -> list[Group]:
+        """The groups with a directive in one of ``spans`` (all of them for None)."""
+        if spans is None:
+            return list(self.groups)
+        ordered = sorted(spans)
+        starts = [start for start, _ in ordered]
+        reach = list(itertools.accumulate((end for _, end in ordered), max))
 
-    def spelling(self, branch: int) -> tuple[bytes, list[tuple[int, int]]]:
-        """The file with every directive line blanked and, unless ``branch`` is ``ALL``, in
-        each group every branch but the ``branch``-th blanked (a group with fewer keeps its
-        last); and the byte ranges of the branches blanked."""
+        def inside(offset: int) -> bool:
+            index = bisect.bisect_right(starts, offset) - 1
+            return index >= 0 and offset < reach[index]
+
+        return [g for g in self.groups if any(inside(d.start) for d in g.directives)]
+
+    def spelling(self, branch: int, groups: list[Group]) -> Spelling:
+        """The file with the directive lines of ``groups`` blanked and, unless ``branch``
+        is ``ALL``, in each of them every branch but the ``branch``-th blanked too (a group
+        with fewer keeps its last)."""
         out = bytearray(self.data)
         set_aside: list[tuple[int, int]] = []
-        for group in self.groups:
+        for group in groups:
             directives = group.directives
             for directive in directives:
                 _blank_code(out, directive.start, directive.end)
@@ -128,16 +141,24 @@ class Conditionals:
                     start, end = directives[index].end, directives[index + 1].start
                     _blank(out, start, end)
                     set_aside.append((start, end))
-        return bytes(out), set_aside
-
-    def decisions(self) -> list[tuple[int, str, int]]:
-        """(byte offset, decision kind, line) of each directive that is a decision."""
-        return [
+        decisions = [
             (directive.start, "#" + directive.keyword, directive.line)
-            for group in self.groups
+            for group in groups
             for directive in group.directives
             if directive.keyword in DECIDING
         ]
+        return Spelling(bytes(out), set_aside, sorted(decisions))
+
+
+@dataclass(frozen=True, slots=True)
+class Spelling:
+    """A file's bytes with some #if directives (and branches) blanked: ``set_aside``, the
+    branches blanked; ``decisions``, (offset, kind, line) of each blanked directive that
+    is a decision where lizard counts one (``#if``, ``#ifdef``, ``#elif``...)."""
+
+    data: bytes
+    set_aside: list[tuple[int, int]]
+    decisions: list[tuple[int, str, int]]
 
 
 _KEEP_NEWLINES = bytes(b if b == 10 else 32 for b in range(256))

@@ -15,6 +15,7 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy
 from tree_sitter import Language as TSLanguage
 from tree_sitter import Node, Parser, Point, Query, QueryError, Tree
 
@@ -89,8 +90,14 @@ def grammar(language: str) -> Grammar:
     return built
 
 
-def syntax_tree(parser: Parser, data: bytes, seconds: float) -> Tree | None:
+def syntax_tree(
+    parser: Parser, data: bytes, seconds: float, old: tuple[Tree, bytes] | None = None
+) -> Tree | None:
     """``data`` parsed, or None when the parse takes longer than ``seconds`` (wall clock).
+
+    ``old``: a tree of other bytes of the same length (the same file with some spans
+    overwritten by spaces); tree-sitter then reparses only around the spans that differ
+    (:func:`edited`), which is what makes a second reading of a file cheap.
 
     tree-sitter asks whether to go on every hundred or so steps of its parse; a cut-off
     parse would resume with the next call, so the parser is reset. (The query that follows
@@ -106,10 +113,39 @@ def syntax_tree(parser: Parser, data: bytes, seconds: float) -> Tree | None:
         return time.monotonic() > deadline
 
     try:
+        if old is not None:
+            return parser.parse(read, old_tree=edited(*old, data), progress_callback=stop)
         return parser.parse(read, progress_callback=stop)
     except ValueError:  # "Parsing failed": cut off
         parser.reset()
         return None
+
+
+_NEAR = 64  # differing spans closer than this are one edit
+
+
+def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
+    """A copy of ``tree`` (of ``before``) told where ``after``, as long, differs from it."""
+    old = numpy.frombuffer(before, dtype=numpy.uint8)
+    new = numpy.frombuffer(after, dtype=numpy.uint8)
+    differ = numpy.flatnonzero(old != new)
+    copy = tree.copy()
+    if not len(differ):
+        return copy
+    breaks = numpy.flatnonzero(numpy.diff(differ) > _NEAR)
+    starts = numpy.concatenate(([differ[0]], differ[breaks + 1]))
+    ends = numpy.concatenate((differ[breaks], [differ[-1]])) + 1
+    newlines = numpy.flatnonzero(old == 10)
+
+    def point(offset: int) -> Point:
+        row = int(numpy.searchsorted(newlines, offset))
+        column = offset - (int(newlines[row - 1]) + 1 if row else 0)
+        return Point(row, column)
+
+    for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
+        begin, finish = point(start), point(end)
+        copy.edit(start, end, end, begin, finish, finish)
+    return copy
 
 
 def deeper_than(root: Node, limit: int) -> bool:

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 # Every repetition is possessive or atomic: a run of macros (``DECLARE(A) DECLARE(B) ...``)
 # that fails to match must fail in one pass, never by trying each way to split it.
-_MACRO = rb"(?=[0-9_]*+[A-Z])[A-Z_][A-Z0-9_]*+"
+# ALL_CAPS, optionally after a library prefix: Py_BEGIN_ALLOW_THREADS, uv_MAYBE_UNUSED
+_MACRO = rb"(?:[A-Za-z][a-z0-9]*+_)?+(?=[0-9_]*+[A-Z])[A-Z_][A-Z0-9_]*+"
 _ARGS = rb"(?>\s*+\((?:[^()]++|\((?:[^()]++|\([^()]*+\))*+\))*+\))"
 _NAME = rb"[A-Za-z_]\w*+"
 _QUALIFIERS = rb"(?:\s*+(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*+"
@@ -44,7 +45,7 @@ def _attribute(names: Sequence[str]) -> bytes:
 
 
 Rule = tuple[re.Pattern[bytes], bool, bool]
-"""(pattern whose group 1 is blanked, applies between declarations only, applies before the
+"""(pattern whose matching group is blanked, applies between declarations only, applies before the
 first parse: a misreading that gives tree-sitter no error, as a class named after its macro)."""
 
 
@@ -52,11 +53,11 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
     macro = _attribute(names.attribute)
     return (
         # class FOO_EXPORT Name : / {     struct PACKED Name {     class LOCKABLE(x) Name
-        (re.compile(rb"\b(?:class|struct|union)\s+(" + macro + _ARGS + rb"?)\s+(?=" + _NAME
-                    + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))"), False, True),
-        # class Name PROTOBUF_FINAL : Base {
-        (re.compile(rb"\b(?:class|struct|union)\s+" + _NAME + rb"\s+(?!final\b)(" + macro
-                    + _ARGS + rb"?)(?=\s*(?::(?!:)|\{))"), False, True),
+        # or, in group 2: class Name PROTOBUF_FINAL : Base {       (one pass for both)
+        (re.compile(rb"\b(?:class|struct|union)\s++(?:(" + macro + _ARGS + rb"?+)\s++(?="
+                    + _NAME + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))|" + _NAME
+                    + rb"\s++(?!final\b)(" + macro + _ARGS + rb"?+)(?=\s*(?::(?!:)|\{)))"),
+         False, True),
         # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT
         (re.compile(rb"(?m)^[ \t]*(" + macro + rb")[ \t]*(?://[^\n]*)?$"), False, False),
         # void Lock() EXCLUSIVE_LOCKS_REQUIRED(mu_);   int f() const OVERRIDE {
@@ -72,7 +73,7 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
     )  # fmt: skip
 
 
-_LINE_RULES = frozenset({2, 4})  # the rules for a macro alone on its line
+_LINE_RULES = frozenset({1, 3})  # the rules for a macro alone on its line
 
 _RULES: dict[MacroNames, tuple[Rule, ...]] = {}
 _LITERALS = re.compile(
@@ -136,10 +137,13 @@ def blank_macros(
     literal = literal_spans(data)
     out = bytearray(data)
     for number, found, between in hits:
-        start, end = found.span(1)
+        start, end = found.span(found.lastindex or 1)  # the group that matched
         if start in literal or (between and start in in_body):
             continue
         if number in _LINE_RULES and not _standalone(data, found.start()):
             continue
-        out[start:end] = re.sub(rb"[^\n]", b" ", found.group(1))
+        out[start:end] = bytes(out[start:end]).translate(_SPACES)
     return bytes(out)
+
+
+_SPACES = bytes(b if b == 10 else 32 for b in range(256))  # every byte but newline

@@ -16,7 +16,7 @@ import pytest
 from tests.gitrepo import GitRepo
 from tests.untrusted import run_cli
 
-PLUGIN = '''
+PLUGIN = """
 import ctypes, os, time
 
 from archmetrics.parsers import LanguageSpec
@@ -38,7 +38,7 @@ def parse(path, source):
 
 
 SPEC = LanguageSpec("unruly", parse)
-'''
+"""
 FINE = "def f{i}(a):\n    if a:\n        return {i}\n    return 0\n"
 
 
@@ -224,3 +224,23 @@ def test_parser_limits_come_from_the_configuration_and_key_the_cache(
     files = _measured(run_cli(["scan", ".", *cache], repo.root).out)
     assert files["big.py"]["loc"] == 400 and files["deep.py"]["loc"] == 1
     assert files["big.py"]["warnings"] == [] and files["deep.py"]["warnings"] == []
+
+
+def test_configured_macros_reach_the_c_parser_and_key_the_cache(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    """A lower-case export macro is not recognised by its spelling; listed under
+    [tool.archmetrics.macros] it is, at once (facts read without the list are not reused)."""
+    source = (
+        "class my_export Proxy : public Base {\n  int get() { if (x) return 1; return 0; }\n};\n"
+    )
+    repo.commit("v1", files={"proxy.cpp": source})
+    cache = ["--cache-path", str(tmp_path / "c.sqlite3"), "--format", "json"]
+    files = _measured(run_cli(["scan", ".", *cache], repo.root).out)
+    functions = files["proxy.cpp"]["functions"]
+    assert [f["qualified_name"] for f in functions] == ["Proxy"]  # type: ignore[attr-defined]
+    repo.write({"pyproject.toml": '[tool.archmetrics.macros]\nattribute = ["my_export"]\n'})
+    files = _measured(run_cli(["scan", ".", *cache], repo.root).out)
+    functions = files["proxy.cpp"]["functions"]
+    assert [(f["qualified_name"], f["vg"]) for f in functions] == [("Proxy::get", 2)]  # type: ignore[attr-defined]
+    assert files["proxy.cpp"]["warnings"] == []
