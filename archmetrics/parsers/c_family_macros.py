@@ -25,6 +25,10 @@ from dataclasses import dataclass
 _MACRO = rb"(?:[A-Za-z][a-z0-9]*+_)?+(?=[0-9_]*+[A-Z])[A-Z_][A-Z0-9_]*+"
 _ARGS = rb"(?>\s*+\((?:[^()]++|\((?:[^()]++|\([^()]*+\))*+\))*+\))"
 _NAME = rb"[A-Za-z_]\w*+"
+_BUILTIN = (
+    rb"(?:(?:const|volatile|unsigned|signed)\s++)*+(?:void|char|short|int|long|float|double"
+    rb"|bool|_Bool|size_t|ssize_t|u?int(?:8|16|32|64|ptr|max)_t|struct|enum|union)\b"
+)
 _QUALIFIERS = rb"(?:\s*+(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*+"
 
 
@@ -70,6 +74,11 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
         # if EQ("a") {   while NOT_DONE(x) {
         (re.compile(rb"\b(?:if|while|switch)\s+(?!constexpr\b)(" + _NAME + rb")(?=\s*\()"), False,
          False),
+        # static BROTLI_INLINE void f(   static CYTHON_INLINE int g(   (a built-in type follows)
+        (re.compile(rb"\b(?:static|extern|inline)\s++(" + macro + rb")(?=\s++" + _BUILTIN + rb")"),
+         True, False),
+        # void f(int * BROTLI_RESTRICT self, ...)   (between a `*` and a parameter's name)
+        (re.compile(rb"\*\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"), False, False),
     )  # fmt: skip
 
 

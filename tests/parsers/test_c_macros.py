@@ -425,3 +425,27 @@ def test_a_rereading_gives_the_facts_a_fresh_parse_gives(monkeypatch: pytest.Mon
     )
     assert [facts_of(source, language) for language, source in sources] == incremental
     assert all(len(facts.functions) >= 1 for facts in incremental)
+
+
+@LANGUAGES
+def test_an_inline_macro_and_a_restrict_macro_around_a_macro_named_function(
+    language: str,
+) -> None:
+    # Brotli's *_inc.h: the name is a macro call too, and stays as written
+    facts = facts_of(
+        """
+        static BROTLI_INLINE void FN(Prepare)(
+            Hasher* BROTLI_RESTRICT self, BROTLI_BOOL one_shot, size_t size) {
+          if (one_shot) self->x = size;
+        }
+        static BROTLI_INLINE size_t FN(HashBytes)(const uint8_t* BROTLI_RESTRICT data) {
+          return data[0] ? 1 : 0;
+        }
+        static DWORD counter;
+        """,
+        language,
+    )
+    assert len(facts.functions) == 2
+    assert [f.complexity for f in facts.functions] == [2, 2]
+    assert [f.span for f in facts.functions] == [Span(2, 5), Span(6, 8)]
+    assert not lost(facts)

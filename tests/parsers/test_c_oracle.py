@@ -35,6 +35,10 @@ CORPUS = (
     ("greenlet-3.1.1.tar.gz", "greenlet==3.1.1", ("src/greenlet",)),
     ("kiwisolver-1.4.7.tar.gz", "kiwisolver==1.4.7", ("kiwi", "py/src")),
 )
+#: Code shaped by macros and #if (docs/metrics.md, "Macros and #if"): export and namespace
+#: macros, diagnostic pragmas as macros, platform #if around statements.
+MACRO_CORPUS = (("python_rapidjson-1.20.tar.gz", "python-rapidjson==1.20", ("rapidjson/include",)),)
+REQUIRED_FOUND = 0.99
 SUFFIXES = {".c": Language.C, ".h": Language.CPP, ".cpp": Language.CPP, ".hpp": Language.CPP}
 REQUIRED_AGREEMENT = 0.98
 
@@ -67,8 +71,12 @@ def _download(folder: Path, requirement: str) -> Path | None:
         subprocess.run(command, check=True, capture_output=True, timeout=240)
     except (subprocess.SubprocessError, OSError):
         return None
-    name = requirement.split("==")[0].lower()
-    found = [p for p in folder.glob("*.tar.gz") if p.name.lower().startswith(name + "-")]
+    name = requirement.split("==")[0].lower().replace("-", "_")
+    found = [
+        p
+        for p in folder.glob("*.tar.gz")
+        if p.name.lower().replace("-", "_").startswith(name + "_")
+    ]
     return found[0] if found else None
 
 
@@ -94,10 +102,22 @@ def _unpacked(folder: Path, archive_name: str, requirement: str) -> Path:
 @pytest.fixture(scope="session")
 def corpus() -> list[tuple[str, str, Language]]:
     """(relative path, source, language) for every C/C++ file in the pinned corpus."""
+    return _files(CORPUS)
+
+
+@pytest.fixture(scope="session")
+def macro_corpus() -> list[tuple[str, str, Language]]:
+    """The same for the pinned macro-heavy corpus."""
+    return _files(MACRO_CORPUS)
+
+
+def _files(
+    corpus: tuple[tuple[str, str, tuple[str, ...]], ...],
+) -> list[tuple[str, str, Language]]:
     folder = _corpus_dir()
     folder.mkdir(parents=True, exist_ok=True)
     files: list[tuple[str, str, Language]] = []
-    for archive_name, requirement, parts in CORPUS:
+    for archive_name, requirement, parts in corpus:
         root = _unpacked(folder, archive_name, requirement)
         for part in parts:
             for path in sorted((root / part).rglob("*")):
@@ -190,3 +210,23 @@ def test_vg_agrees_with_lizard(corpus: list[tuple[str, str, Language]]) -> None:
     print(f"\n{compared} functions compared, agreement {agreement:.4f}\n{report}")
     assert agreement >= REQUIRED_AGREEMENT, report
     assert not by_class.get("unexplained"), report
+
+
+@pytest.mark.parametrize("which", ["corpus", "macro_corpus"])
+def test_the_functions_lizard_finds_are_found(which: str, request: pytest.FixtureRequest) -> None:
+    """Issue 13: no function lost to a macro or an #if. Found: one of ours ends on the line
+    where lizard's ends and spans its first line (benchmarks/oracle_c.py, larger corpora)."""
+    files: list[tuple[str, str, Language]] = request.getfixturevalue(which)
+    total, missed = 0, []
+    for path, source, language in files:
+        ours = c_family.parse(path, source, language).functions
+        ends = _keyed((f.span.end, f) for f in ours)
+        for other in lizard.analyze_file.analyze_source_code(path, source).function_list:
+            total += 1
+            mine = ends.get(other.end_line)
+            if not isinstance(mine, Function) or not mine.span.contains(other.start_line):
+                missed.append(f"{path}:{other.start_line} {other.long_name[:80]}")
+    assert total > 1000, f"only {total} functions from lizard; corpus broken"
+    found = 1 - len(missed) / total
+    print(f"\n{which}: {total} lizard functions, found {found:.4f}")
+    assert found >= REQUIRED_FOUND, "\n".join(missed[:30])
