@@ -40,7 +40,7 @@ from archmetrics.parsers.c_family_names import (
     in_order,
     typedef_names,
 )
-from archmetrics.parsers.c_family_outline import classes, includes, warnings
+from archmetrics.parsers.c_family_outline import Counted, classes, includes, warnings
 from archmetrics.parsers.c_family_regions import Choice, Layout, choose
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
 from archmetrics.parsers.c_family_text import blank_comments, sloc
@@ -352,6 +352,7 @@ def _facts(
         nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
     )
     _decisions(found, owner, reading.directive_decisions)
+    call_sites = CallSites(found.get("call", []), data).sites(owner.name)
     return FileFacts(
         path=path,
         language=str(language),
@@ -361,9 +362,19 @@ def _facts(
         ),
         classes=classes(found.get("class", []), scopes),
         dependencies=includes(nodes, data),
-        call_sites=CallSites(found.get("call", []), data).sites(owner.name),
+        call_sites=call_sites,
         sloc=sloc(clean),
-        warnings=warnings(path, {**found, "expected": found.get("expected", []) + explained}, data),
+        warnings=warnings(
+            path,
+            {**found, "expected": found.get("expected", []) + explained},
+            data,
+            clean,
+            Counted(
+                sorted(d.line for s in slots for d in s.decisions),
+                sorted(s.span.start for s in facts_statements),
+                sorted(c.span.start for c in call_sites),
+            ),
+        ),
     )
 
 

@@ -12,6 +12,7 @@ from archmetrics.reports.model import (
     ScanReport,
     SeriesReport,
 )
+from archmetrics.reports.printable import shown_warnings
 
 
 def escape(cell: object) -> str:
@@ -55,7 +56,7 @@ def render_scan(report: ScanReport, grouping: str) -> str:
         f"{t.files} files, {t.functions} functions: λ = {t.loc}, SLOC = {t.sloc}, v_g = {t.vg}\n",
         _scan_table(report, grouping),
     ]
-    warnings = [w for f in report.files for w in f.warnings]
+    warnings = shown_warnings([w for f in report.files for w in f.warnings])
     if warnings:
         parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
     return "\n".join(parts)
@@ -84,7 +85,7 @@ def render_diff(report: DiffReport) -> str:
     bullets = [f"- {f}" for f in report.failures]
     bullets += [f"- note {n}" for n in diff_rows.notes(report)]
     bullets += [f"- excluded `{x.path}`: {x.reason}" for x in report.change.excluded]
-    bullets += [f"- warning `{w}`" for w in report.warnings]
+    bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
     if bullets:
         parts.append("\n".join(bullets) + "\n")
     return "\n".join(parts)

@@ -10,6 +10,7 @@ return) are kept in reports and escaped in one-line messages.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff]")
 _LAYOUT = re.compile(r"[\t\n\r\u2028\u2029]")
@@ -29,3 +30,19 @@ def one_line(text: str, limit: int = 2000) -> str:
     """``text`` as one printable line of at most ``limit`` characters."""
     line = _LAYOUT.sub(_escape, printable(text))
     return line if len(line) <= limit else line[: limit - 1] + "…"
+
+
+SHOWN_WARNINGS = 20
+"""Warnings a table or Markdown report lists before it summarises the rest (JSON lists all)."""
+
+
+def shown_warnings(warnings: Sequence[object], limit: int = SHOWN_WARNINGS) -> list[str]:
+    """The first ``limit`` warnings as text, then one line counting the rest and the files
+    they are in (a warning's ``path``, when it has one)."""
+    shown = [str(warning) for warning in warnings[:limit]]
+    rest = warnings[limit:]
+    if rest:
+        files = {getattr(warning, "path", None) for warning in rest} - {None}
+        where = f" in {len(files)} files" if files else ""
+        shown.append(f"... and {len(rest)} more warnings{where} (--format json lists them all)")
+    return shown

@@ -16,6 +16,7 @@ from archmetrics.reports.model import (
     ScanReport,
     SeriesReport,
 )
+from archmetrics.reports.printable import shown_warnings
 
 
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
@@ -84,7 +85,7 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
         table = rows_table(title, coupling_rows.LINK_HEADER, rows, 8)
     else:
         table = _file_table(report)
-    warnings = [str(w) for f in report.files for w in f.warnings]
+    warnings = shown_warnings([w for f in report.files for w in f.warnings])
     extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
 
@@ -108,7 +109,7 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
-    lines += [f"warning {w}" for w in report.warnings]
+    lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
     lines += [str(f) for f in report.failures]
     return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
 

@@ -1,0 +1,29 @@
+"""Reports list at most a screenful of warnings and count the rest (JSON keeps them all)."""
+
+from __future__ import annotations
+
+import json
+
+from archmetrics.reports.printable import SHOWN_WARNINGS
+from tests.gitrepo import GitRepo
+from tests.untrusted import run_cli
+
+# a file scope tree-sitter cannot read (abseil's flag macros take a type as an argument)
+LOSSY = """ABSL_FLAG(int, flag_a, 0, "help");
+namespace {
+int f(int a) { if (a) return 1; return 2; }
+}
+"""
+
+
+def test_a_scan_lists_twenty_warnings_and_counts_the_rest(repo: GitRepo) -> None:
+    files = {f"src/flags_{i:02}.cc": LOSSY for i in range(SHOWN_WARNINGS + 5)}
+    repo.commit("v1", files=files)
+    every = json.loads(run_cli(["scan", ".", "--no-cache", "--format", "json"], repo.root).out)
+    warnings = [w for f in every["files"] for w in f["warnings"]]
+    assert len(warnings) == SHOWN_WARNINGS + 5
+    assert all("could not be parsed" in w["message"] for w in warnings)
+    for form in ("table", "markdown"):
+        out = run_cli(["scan", ".", "--no-cache", "--format", form], repo.root).out
+        assert out.count("could not be parsed") == SHOWN_WARNINGS
+        assert "... and 5 more warnings in 5 files (--format json lists them all)" in out
