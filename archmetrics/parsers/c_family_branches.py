@@ -63,21 +63,19 @@ _COMMENT = re.compile(rb"//[^\n]*|/\*(?:[^*]|\*(?!/))*\*/")
 
 def _directive_end(data: bytes, start: int) -> int:
     """Where the directive at ``start`` ends: the end of its line and continuation lines,
-    or the start of a block comment that runs past them."""
-    end = start
+    or the start of a block comment that runs past them. Each line is looked at once."""
+    line = start
     while True:
-        newline = data.find(b"\n", end)
+        newline = data.find(b"\n", line)
         if newline < 0:
-            end = len(data)
-            break
-        opened = data.rfind(b"/*", start, newline)
+            return len(data)
+        opened = data.rfind(b"/*", line, newline)
         if opened >= 0 and data.find(b"*/", opened + 2, newline) < 0:
             return opened
-        end = newline
-        if not data[start:newline].rstrip(b"\r").endswith(b"\\"):
-            break
-        end = newline + 1
-    return end
+        last = newline - 1 if newline > line and data[newline - 1] == 13 else newline  # \r
+        if last <= line or data[last - 1] != 92:  # no `\` before the line's end
+            return newline
+        line = newline + 1
 
 
 class Conditionals:
@@ -90,15 +88,17 @@ class Conditionals:
         groups: list[Group] = []
         stack: list[list[Directive]] = []
         line, last = 1, 0
+        ended = 0  # where the last directive (and its continuation lines) ended
         for found in _DIRECTIVE.finditer(data):
             start = found.start()
-            if start in literals:
+            if start < ended or start in literals:
                 continue
             line += data.count(b"\n", last, start)
             last = start
             hash_at = data.index(b"#", start)
             keyword = found.group(1).decode()
             directive = Directive(hash_at, _directive_end(data, hash_at), keyword, line)
+            ended = directive.end
             if keyword in _OPENS:
                 stack.append([directive])
             elif stack and keyword in _MIDDLE:

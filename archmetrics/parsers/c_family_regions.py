@@ -13,6 +13,7 @@ changes.
 from __future__ import annotations
 
 import bisect
+import collections
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
@@ -83,10 +84,11 @@ class Layout:
         (an ERROR node, a token it had to invent), and the code (not the white space) of
         the branches its spelling set aside; then the number of tokens it invented."""
         lost = _overlap(self.broken, start, end)
-        for s, e in self.set_aside[_first(self.set_aside, start) :]:
-            if s >= end:
-                break
+        aside, index = self.set_aside, _first(self.set_aside, start)
+        while index < len(aside) and aside[index][0] < end:
+            s, e = aside[index]
             lost += len(self.data[max(start, s) : min(end, e)].translate(None, b" \t\r\n"))
+            index += 1
         invented = bisect.bisect_right(self.missing, end) - bisect.bisect_left(self.missing, start)
         return lost, invented
 
@@ -99,10 +101,11 @@ def _first(ranges: list[tuple[int, int]], start: int) -> int:
 def _overlap(ranges: list[tuple[int, int]], start: int, end: int) -> int:
     """How many bytes of sorted, disjoint ``ranges`` lie in ``[start, end)``."""
     total = 0
-    for s, e in ranges[_first(ranges, start) :]:
-        if s >= end:
-            break
+    index = _first(ranges, start)
+    while index < len(ranges) and ranges[index][0] < end:
+        s, e = ranges[index]
         total += max(0, min(end, e) - max(start, s))
+        index += 1
     return total
 
 
@@ -157,10 +160,13 @@ def choose(base: Layout, others: Sequence[Layout]) -> list[Choice]:
     """For each damaged region of ``base``, the spelling (an index into ``others``) that reads
     it with the least damage, if one reads it with less than the base; regions do not
     overlap. Ties go to the earlier spelling."""
-    choices: list[Choice] = []
-    pending = list(base.damaged)
+    choices: list[Choice] = []  # sorted, disjoint
+    pending = collections.deque(base.damaged)
     while pending:
-        start, end = pending.pop(0)
+        start, end = pending.popleft()
+        index = bisect.bisect_right(choices, start, key=lambda c: c.start) - 1
+        if index >= 0 and end <= choices[index].end:
+            continue  # a region chosen before holds this one
         best: Choice | None = None
         best_damage: Damage | None = None
         for reader, other in enumerate(others):
@@ -170,14 +176,14 @@ def choose(base: Layout, others: Sequence[Layout]) -> list[Choice]:
                 best, best_damage = Choice(s, e, reader), damage
         if best is None:
             continue
-        overlapping = [c for c in choices if c.start < best.end and best.start < c.end]
+        low = bisect.bisect_left(choices, best.start, key=lambda c: c.end)  # first ending after
+        high = bisect.bisect_left(choices, best.end, key=lambda c: c.start)  # first starting after
+        overlapping = choices[low:high]
         if overlapping:  # two regions grew into one: choose again for their union
-            choices = [c for c in choices if c not in overlapping]
-            union = (min([best.start] + [c.start for c in overlapping]),
-                     max([best.end] + [c.end for c in overlapping]))  # fmt: skip
+            union = (min(best.start, overlapping[0].start), max(best.end, overlapping[-1].end))
+            del choices[low:high]
             if union != (best.start, best.end) or len(overlapping) > 1:
-                pending.insert(0, union)
+                pending.appendleft(union)
                 continue
-        choices.append(best)
-        pending = [(s, e) for s, e in pending if not (best.start <= s and e <= best.end)]
-    return sorted(choices, key=lambda c: c.start)
+        choices.insert(low, best)
+    return choices

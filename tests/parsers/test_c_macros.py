@@ -449,3 +449,22 @@ def test_an_inline_macro_and_a_restrict_macro_around_a_macro_named_function(
     assert [f.complexity for f in facts.functions] == [2, 2]
     assert [f.span for f in facts.functions] == [Span(2, 5), Span(6, 8)]
     assert not lost(facts)
+
+
+# --- hostile input: every rereading step is linear in the file ------------------------------
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        "#if A\n" + "/*" * 100_000 + "\n#endif\n",  # a comment opened 100,000 times
+        '#if A\nint x = 1;\n#endif\nchar *s = "' + '"a' * 100_000 + "\n",  # quotes never closed
+        "#if A \\\n" * 50_000 + "x\n#endif\nint g(void) { return 1; }\n",  # one long directive
+        "#if A\nint x;\n#endif\n" + "int f() { @ }\n" * 20_000,  # 20,000 damaged regions
+    ],
+    ids=["open-comments", "open-strings", "continued-directive", "many-regions"],
+)
+def test_pathological_preprocessor_input_is_read_in_near_linear_time(source: str) -> None:
+    # each of these took minutes to hours when a step rescanned the rest of the file
+    facts = facts_of(source, "c")
+    assert facts.parsed
