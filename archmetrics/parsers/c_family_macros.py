@@ -79,10 +79,18 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
          True, False),
         # void f(int * BROTLI_RESTRICT self, ...)   (between a `*` and a parameter's name)
         (re.compile(rb"\*\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"), False, False),
+        # ABSL_FLAG(int, name, 0, "help");  a type among a macro call's arguments: the type's
+        # words (not blanked: rewritten as one identifier of the same length) in group 1
+        (re.compile(rb"(?m)^[ \t]*+" + macro + rb"(" + _ARGS + rb")"), True, False),
     )  # fmt: skip
 
 
 _LINE_RULES = frozenset({1, 3})  # the rules for a macro alone on its line
+_TYPE_RULES = frozenset({7})  # the rule that rewrites types among a call's arguments
+_TYPE_WORDS = re.compile(
+    rb"\b(?:(?:unsigned|signed|const|volatile|long|short)\s++)*+(?:bool|char|short|int|long"
+    rb"|float|double|void|unsigned|signed|size_t|u?int(?:8|16|32|64)_t)\b(?!\s*+\()"
+)
 
 _RULES: dict[MacroNames, tuple[Rule, ...]] = {}
 # A literal or comment left open runs to the end of its line (strings) or of the file (raw
@@ -154,6 +162,9 @@ def blank_macros(
         if start in literal or (between and start in in_body):
             continue
         if number in _LINE_RULES and not _standalone(data, found.start()):
+            continue
+        if number in _TYPE_RULES:
+            out[start:end] = _TYPE_WORDS.sub(lambda m: b"_" * len(m[0]), bytes(out[start:end]))
             continue
         out[start:end] = bytes(out[start:end]).translate(_SPACES)
     return bytes(out)

@@ -497,20 +497,20 @@ def test_a_macro_error_that_loses_nothing_is_not_warned_about() -> None:
 
 def test_a_region_that_loses_facts_is_warned_about_once_with_its_lines_and_losses() -> None:
     source = """
-    // flags
-    ABSL_FLAG(int, flag_a, 0, "help");
-    ABSL_FLAG(bool, flag_b, false, "help");
-    namespace {
-    int f(int a) { if (a) return 1; return 2; }
-    int g(int a) { while (a) a--; return h(a); }
-    }
+    template <typename T> class A {
+      int f(int a) { if (a) return 1; return 2; }
+      DECLARE_THING(x) = [](int y) { if (y) return k(y); return 0; }
+      int g(int a) { while (a) a--; return h(a); }
+    };
     """
-    [warning] = facts_of(source, "cpp").warnings
-    assert warning.line == 3
+    facts = facts_of(source, "cpp")
+    [warning] = facts.warnings
+    assert warning.line == 4
     assert warning.message == (
-        "lines 3-8 could not be parsed ('ABSL_FLAG(int, flag_a, 0, \"help\");': a macro or"
-        " an #if?); not counted there: about 2 decisions, 6 statements, 5 call sites"
+        "line 4 could not be parsed ('DECLARE_THING(x) = [](int y) { if (y) re': a macro or"
+        " an #if?); not counted there: about 1 decision, 1 call site"
     )
+    assert complexities(facts) == {"A::f": 2, "A::g": 2}  # the rest is measured
 
 
 @pytest.mark.parametrize(

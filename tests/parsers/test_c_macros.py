@@ -468,3 +468,23 @@ def test_pathological_preprocessor_input_is_read_in_near_linear_time(source: str
     # each of these took minutes to hours when a step rescanned the rest of the file
     facts = facts_of(source, "c")
     assert facts.parsed
+
+
+@LANGUAGES
+def test_a_type_among_a_file_scope_macro_calls_arguments(language: str) -> None:
+    # abseil's flags: the call stays a statement and a call site, as written
+    facts = facts_of(
+        """
+        ABSL_FLAG(int, flag_a, 0, "help");
+        ABSL_FLAG(unsigned short, flag_b, false, "help");
+        int f(int a) { if (a) return 1; return 2; }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"f": 2}
+    assert [s.text for s in facts.statements[:2]] == [
+        'ABSL_FLAG ( int , flag_a , 0 , "help" ) ;',
+        'ABSL_FLAG ( unsigned short , flag_b , false , "help" ) ;',
+    ]
+    assert [site.name for site in facts.call_sites] == ["ABSL_FLAG", "ABSL_FLAG"]
+    assert not lost(facts)
