@@ -25,6 +25,7 @@ import re
 from dataclasses import dataclass
 
 from archmetrics.parsers.c_family_macros import literal_spans
+from archmetrics.parsers.c_family_text import blank
 
 _DIRECTIVE = re.compile(rb"(?m)^[ \t]*#[ \t]*(ifdef|ifndef|if|elifdef|elifndef|elif|else|endif)\b")
 _OPENS = frozenset({"if", "ifdef", "ifndef"})
@@ -139,7 +140,7 @@ class Conditionals:
             for index in range(group.branches):
                 if index != keep:
                     start, end = directives[index].end, directives[index + 1].start
-                    _blank(out, start, end)
+                    blank(out, start, end)
                     set_aside.append((start, end))
         decisions = [
             (directive.start, "#" + directive.keyword, directive.line)
@@ -161,17 +162,10 @@ class Spelling:
     decisions: list[tuple[int, str, int]]
 
 
-_KEEP_NEWLINES = bytes(b if b == 10 else 32 for b in range(256))
-
-
-def _blank(out: bytearray, start: int, end: int) -> None:
-    out[start:end] = bytes(out[start:end]).translate(_KEEP_NEWLINES)
-
-
 def _blank_code(out: bytearray, start: int, end: int) -> None:
     """Blank ``[start, end)`` but the comments in it."""
     at = start
     for comment in _COMMENT.finditer(out, start, end):
-        _blank(out, at, comment.start())
+        blank(out, at, comment.start())
         at = comment.end()
-    _blank(out, at, end)
+    blank(out, at, end)

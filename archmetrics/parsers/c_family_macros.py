@@ -19,6 +19,8 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from archmetrics.parsers.c_family_text import blank
+
 # Every repetition is possessive or atomic: a run of macros (``DECLARE(A) DECLARE(B) ...``)
 # that fails to match must fail in one pass, never by trying each way to split it.
 # ALL_CAPS, optionally after a library prefix: Py_BEGIN_ALLOW_THREADS, uv_MAYBE_UNUSED
@@ -166,8 +168,5 @@ def blank_macros(
         if number in _TYPE_RULES:
             out[start:end] = _TYPE_WORDS.sub(lambda m: b"_" * len(m[0]), bytes(out[start:end]))
             continue
-        out[start:end] = bytes(out[start:end]).translate(_SPACES)
+        blank(out, start, end)
     return bytes(out)
-
-
-_SPACES = bytes(b if b == 10 else 32 for b in range(256))  # every byte but newline

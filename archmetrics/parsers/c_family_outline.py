@@ -11,7 +11,7 @@ from tree_sitter import Node
 from archmetrics.facts import Class, Dependency, DependencyKind, ParseWarning
 from archmetrics.parsers import c_tables
 from archmetrics.parsers.c_family_names import Scopes, in_order, span, text
-from archmetrics.parsers.c_family_text import string_value
+from archmetrics.parsers.c_family_text import string_value, whole_lines
 
 _MAX_WARNINGS = 20
 
@@ -86,9 +86,7 @@ def warnings(
     ]  # (tree-sitter-cpp wants a declarator in `template class Box<int>;`: expected)
     regions: list[tuple[int, int]] = []
     for start, end in sorted(spots):
-        start = data.rfind(b"\n", 0, start) + 1
-        after = data.find(b"\n", end)
-        end = len(data) if after < 0 else after
+        start, end = whole_lines(data, start, end)
         if regions and start <= regions[-1][1] + 1:
             regions[-1] = (regions[-1][0], max(end, regions[-1][1]))
         else:

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 from tree_sitter import Node
 
+from archmetrics.parsers.c_family_text import whole_lines
+
 #: The captures that give a parse its shape: a region never cuts one of them in two.
 STRUCTURE = ("stmt", "class", "namespace", "body", "error")
 
@@ -62,7 +64,7 @@ class Layout:
         self.errors = errors
         self.missing = sorted(node.start_byte for node in found.get("missing", []))
         self.broken = _union(
-            [_lines(data, s, e) for s, e in errors + [(m, m) for m in self.missing]]
+            [whole_lines(data, s, e) for s, e in errors + [(m, m) for m in self.missing]]
         )
         self.set_aside = sorted(set_aside)
         self.damaged = _union(errors + [_around(node) for node in found.get("missing", [])])
@@ -107,12 +109,6 @@ def _overlap(ranges: list[tuple[int, int]], start: int, end: int) -> int:
         total += max(0, min(end, e) - max(start, s))
         index += 1
     return total
-
-
-def _lines(data: bytes, start: int, end: int) -> tuple[int, int]:
-    """``[start, end)`` grown to whole lines."""
-    after = data.find(b"\n", end)
-    return data.rfind(b"\n", 0, start) + 1, len(data) if after < 0 else after
 
 
 def _union(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:

@@ -171,6 +171,17 @@ _CODE_LINE = re.compile(rb"^[ \t\f\v\r]*[^\s]", re.MULTILINE)
 _BLANK = bytes(byte if byte in b"\r\n" else 0x20 for byte in range(256))
 
 
+def blank(out: bytearray, start: int, end: int) -> None:
+    """Overwrite ``out[start:end]`` with spaces, line ends kept (every offset and line stays)."""
+    out[start:end] = bytes(out[start:end]).translate(_BLANK)
+
+
+def whole_lines(data: bytes, start: int, end: int) -> tuple[int, int]:
+    """``[start, end)`` grown to whole lines (the last one's newline excluded)."""
+    after = data.find(b"\n", end)
+    return data.rfind(b"\n", 0, start) + 1, len(data) if after < 0 else after
+
+
 def blank_comments(data: bytes, comments: Iterable[tuple[int, int]]) -> bytes:
     """``data`` with comments and line continuations turned to spaces; offsets and lines kept."""
     parts: list[bytes] = []
