@@ -23,13 +23,15 @@ from archmetrics.facts import (
     Span,
 )
 from archmetrics.parsers import c_tables
-from archmetrics.parsers.c_family_branches import ALL, Conditionals
+from archmetrics.parsers.c_family_branches import ALL, Conditionals, Group
 from archmetrics.parsers.c_family_calls import CallSites
 from archmetrics.parsers.c_family_definitions import Definition, definitions
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
     Grammar,
     deeper_than,
+    errors_and_missing,
+    function_bodies,
     grammar,
     syntax_tree,
 )
@@ -41,7 +43,7 @@ from archmetrics.parsers.c_family_names import (
     typedef_names,
 )
 from archmetrics.parsers.c_family_outline import Counted, classes, includes, warnings
-from archmetrics.parsers.c_family_regions import Choice, Layout, choose
+from archmetrics.parsers.c_family_regions import Choice, Layout, choose, damaged, joined
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
 from archmetrics.parsers.c_family_text import blank_comments, sloc
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, not_measured
@@ -106,6 +108,7 @@ class Reading:
     tree: Tree
     found: dict[str, list[Node]]
     damage: tuple[int, int]  # bytes inside outermost ERROR nodes, tokens the parser invented
+    complete: bool = True  # False: only the ERROR and MISSING nodes were found
 
     @property
     def root(self) -> Node:
@@ -119,10 +122,13 @@ class Reading:
         limits: ParseLimits,
         like: Reading | None = None,
         within: tuple[int, int] | None = None,
+        damage_only: bool = False,
     ) -> Reading | str:
         """The reading of ``data``, or why there is none (a limit). ``like``: a reading of
         the same file with other spans blanked, whose tree the parse reuses; ``within``:
-        only the captures that overlap these bytes are wanted."""
+        only the captures that overlap these bytes are wanted; ``damage_only``: if the
+        parse has errors, only they and the tokens it invented are found (``completed``
+        takes the captures; a clean parse is captured at once)."""
         old = (like.tree, like.data) if like is not None else None
         tree = syntax_tree(built.parser, data, limits.parse_seconds, old)
         if tree is None:
@@ -138,11 +144,21 @@ class Reading:
                 if depth == limits.max_depth
                 else "tree-sitter's query cannot go deeper"
             )
+        if damage_only and root.has_error:
+            found = errors_and_missing(root)
+            return cls(data, tree, found, _damage(found), complete=False)
         cursor = QueryCursor(built.query)
         if within is not None:
             cursor.set_byte_range(*within)
         found = cursor.captures(root)
         return cls(data, tree, found, _damage(found))
+
+    def completed(self, built: Grammar) -> Reading:
+        """This reading with every capture of the full query."""
+        if self.complete:
+            return self
+        found = QueryCursor(built.query).captures(self.root)
+        return Reading(self.data, self.tree, found, _damage(found))
 
     def standalone(self) -> list[Node]:
         """The type specifiers that are a statement of their own (``struct S { ... };``)."""
@@ -150,6 +166,8 @@ class Reading:
 
     def bodies(self) -> list[tuple[int, int]]:
         """Byte ranges of the function bodies this parse found."""
+        if not self.complete:
+            return function_bodies(self.root)
         ranges = []
         for node in self.found.get("stmt", []):
             body = node.child_by_field_name("body") if node.type == c_tables.FUNCTION else None
@@ -190,7 +208,8 @@ class Composite:
 def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
-    reading = Reading.of(built, blank_macros(data, names=limits.c_macros, first=True), limits)
+    first = blank_macros(data, names=limits.c_macros, first=True)
+    reading = Reading.of(built, first, limits, damage_only=True)
     if isinstance(reading, str):
         return not_measured(path, str(language), 1, reading)
     if reading.root.has_error:
@@ -202,14 +221,25 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
     """The first parse had errors: parse again with the macros tree-sitter cannot know
-    blanked (c_family_macros.py), and keep whichever parse lost less."""
-    blanked = blank_macros(reading.data, reading.bodies(), limits.c_macros)
-    if blanked == reading.data:
-        return reading
-    second = Reading.of(built, blanked, limits, reading)
-    if isinstance(second, str) or second.damage >= reading.damage:
-        return reading
-    return second
+    blanked (c_family_macros.py), first only those near the damage, then (if damage is
+    left) all of them, and keep whichever parse lost least. Blanking only near the damage
+    keeps a macro-like word that was read well elsewhere (a return type ``PVOID`` alone on
+    its line above a function's name)."""
+    bodies = reading.bodies()
+    damage = damaged(reading.found, reading.data)
+    near = [_around(reading.data, [span], _SUSPECT_LINES) for span in damage]
+    best, tried = reading, {reading.data}
+    for spans in (joined(near), None):
+        if spans is None and best.damage == (0, 0):
+            break
+        blanked = blank_macros(reading.data, bodies, limits.c_macros, near=spans)
+        if blanked in tried:
+            continue
+        tried.add(blanked)
+        other = Reading.of(built, blanked, limits, reading, damage_only=True)
+        if not isinstance(other, str) and other.damage < best.damage:
+            best = other
+    return best.completed(built)
 
 
 def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composite | None:
@@ -218,36 +248,41 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     conditionals = Conditionals(reading.data)
     if not conditionals.groups:
         return None
-    base = Layout(reading.found, reading.data)
-    if not base.damaged:
+    damage = damaged(reading.found, reading.data)
+    if not damage:
         return None
+    # only the groups near the damage are read otherwise, and only the captures there are
+    # taken, unless a region grows past that window: then the whole file is read again
+    window: tuple[int, int] | None = _around(reading.data, damage, _CONTEXT_LINES)
+    base = Layout(reading.found, reading.data, within=window)
     readings: list[Reading] = []
     layouts: list[Layout] = []
     found_in: list[list[tuple[int, str, int]]] = []  # the blanked directives' decisions
     choices: list[Choice] = []
-    # only the groups near the damage are read otherwise, and only the captures there are
-    # taken, unless a region grows past that window: then the whole file is read again
     groups = conditionals.near(_suspects(reading.data, base))
     if not groups:
         return None  # no #if near the damage: another spelling would read it alike
-    window: tuple[int, int] | None = _around(reading.data, base.damaged, _CONTEXT_LINES)
     spellings = [ALL, *range(min(max(g.branches for g in groups), BRANCH_SPELLINGS))]
     index = 0
+    reduced: list[Group] | None = None  # the groups one branch at a time: near ALL's damage
     while index < len(spellings):
-        spelling = conditionals.spelling(spellings[index], groups)
+        spelling = conditionals.spelling(spellings[index], groups, reduced)
         other = Reading.of(built, spelling.data, limits, reading, window)
         index += 1
         if isinstance(other, str):
             continue
         readings.append(other)
         layouts.append(Layout(other.found, reading.data, spelling.set_aside))
+        if spellings[index - 1] == ALL:
+            reduced = _still_damaged(reading.data, groups, layouts[-1])
         found_in.append(spelling.decisions)
         choices = choose(base, layouts)
         if window is not None and not all(
             window[0] <= c.start and c.end <= window[1] for c in choices
         ):
             window, index, readings, layouts, found_in = None, 0, [], [], []
-            groups = conditionals.near(None)
+            groups, reduced = conditionals.near(None), None
+            base = Layout(reading.found, reading.data)
             continue
         if _all_read(base, layouts, choices):
             break
@@ -270,6 +305,16 @@ def _suspects(data: bytes, base: Layout) -> list[tuple[int, int]]:
             (s, e) for s, e, kind in base.crossing(start, end) if kind == c_tables.FUNCTION
         )
     return spans
+
+
+def _still_damaged(data: bytes, groups: list[Group], every: Layout) -> list[Group] | None:
+    """Of ``groups``, those with a directive near the damage left where every branch was
+    kept (``every``): only they need reading one branch at a time (None: all of them)."""
+    if not every.damaged:
+        return None
+    near = [_around(data, [span], _SUSPECT_LINES) for span in every.damaged]
+    chosen = Conditionals.near_in(groups, near)
+    return chosen or None
 
 
 def _around(data: bytes, damaged: list[tuple[int, int]], lines: int) -> tuple[int, int]:
@@ -477,7 +522,7 @@ def _decisions(
     not_decisions = {node.id for node in found.get("nodecision", [])}
     directives = sorted((node.start_byte, node.end_byte) for node in found.get("directive", []))
     directive_starts = [start for start, _ in directives]
-    for node in in_order(found.get("decision", [])):
+    for node in in_order(found.get("decision", []) + found.get("catch", [])):
         offset = node.start_byte
         slot = owner.at(offset)
         if slot is None or node.id in not_decisions:
@@ -486,7 +531,7 @@ def _decisions(
         if index >= 0 and offset < directives[index][1]:
             continue  # inside `#if A && B`
         if slot.body_start <= offset < slot.body_end:
-            kind = c_tables.DECISIONS[node.type]
+            kind = c_tables.DECISIONS.get(node.type, "catch")  # an identifier `catch`
             slot.decisions.append(Decision(kind, node.start_point.row + 1))
     for offset, kind, line in directives_read:
         slot = owner.at(offset)

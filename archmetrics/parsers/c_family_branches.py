@@ -22,6 +22,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from archmetrics.parsers.c_family_macros import literal_spans
@@ -114,6 +115,11 @@ class Conditionals:
         """The groups with a directive in one of ``spans`` (all of them for None)."""
         if spans is None:
             return list(self.groups)
+        return self.near_in(self.groups, spans)
+
+    @staticmethod
+    def near_in(groups: Iterable[Group], spans: list[tuple[int, int]]) -> list[Group]:
+        """Of ``groups``, those with a directive in one of ``spans``."""
         ordered = sorted(spans)
         starts = [start for start, _ in ordered]
         reach = list(itertools.accumulate((end for _, end in ordered), max))
@@ -122,19 +128,22 @@ class Conditionals:
             index = bisect.bisect_right(starts, offset) - 1
             return index >= 0 and offset < reach[index]
 
-        return [g for g in self.groups if any(inside(d.start) for d in g.directives)]
+        return [g for g in groups if any(inside(d.start) for d in g.directives)]
 
-    def spelling(self, branch: int, groups: list[Group]) -> Spelling:
+    def spelling(
+        self, branch: int, groups: list[Group], only: list[Group] | None = None
+    ) -> Spelling:
         """The file with the directive lines of ``groups`` blanked and, unless ``branch``
-        is ``ALL``, in each of them every branch but the ``branch``-th blanked too (a group
-        with fewer keeps its last)."""
+        is ``ALL``, in each of them (or of those also in ``only``) every branch but the
+        ``branch``-th blanked too (a group with fewer keeps its last)."""
         out = bytearray(self.data)
         set_aside: list[tuple[int, int]] = []
+        reduced = set(groups if only is None else only)
         for group in groups:
             directives = group.directives
             for directive in directives:
                 _blank_code(out, directive.start, directive.end)
-            if branch == ALL:
+            if branch == ALL or group not in reduced:
                 continue
             keep = min(branch, group.branches - 1)
             for index in range(group.branches):

@@ -53,6 +53,7 @@ def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule])
         f"[{specifiers}] @specifier",  # kept only where they stand alone (c_family.py)
         *c_tables.NOT_STATEMENTS,
         f"[{tokens}] @decision",
+        c_tables.CATCH_READ_AS_FUNCTION,
         *c_tables.NOT_DECISIONS,
         *c_tables.DIRECTIVE_CONDITIONS,
         f"[{classes}] @class",
@@ -146,6 +147,55 @@ def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
         begin, finish = point(start), point(end)
         copy.edit(start, end, end, begin, finish, finish)
     return copy
+
+
+def errors_and_missing(root: Node) -> dict[str, list[Node]]:
+    """A tree's ``ERROR`` nodes and the tokens its parser invented (``MISSING``), as the
+    query's ``error`` and ``missing`` captures would give them, in no order. Found without
+    a query: only children that hold an error are entered (``has_error``), so a clean
+    stretch of the file costs nothing, where a query walks every node."""
+    errors: list[Node] = []
+    missing: list[Node] = []
+    stack = [root] if root.has_error else []
+    if root.is_error:
+        errors.append(root)  # nothing of the file could be read
+    while stack:
+        for child in stack.pop().children:
+            if child.is_missing:
+                missing.append(child)
+            elif child.is_error:
+                errors.append(child)  # (an ERROR leaf inside an ERROR may lack has_error)
+            if child.has_error:
+                stack.append(child)
+    return {"error": errors, "missing": missing}
+
+
+#: Nodes that may hold a function definition between declarations.
+_HOLDERS = frozenset(
+    {
+        "translation_unit", "namespace_definition", "declaration_list", "linkage_specification",
+        "template_declaration", "declaration", "type_definition", "field_declaration_list",
+        "class_specifier", "struct_specifier", "union_specifier", "field_declaration",
+        "friend_declaration", "ERROR", "preproc_if",
+        "preproc_ifdef", "preproc_else", "preproc_elif", "preproc_elifdef",
+    }
+)  # fmt: skip
+
+
+def function_bodies(root: Node) -> list[tuple[int, int]]:
+    """Byte ranges of the bodies of the functions between declarations (not those inside a
+    body, nor in an initializer: only declaration-holding nodes are entered)."""
+    ranges: list[tuple[int, int]] = []
+    stack = [root]
+    while stack:
+        for child in stack.pop().children:
+            if child.type == "function_definition":
+                body = child.child_by_field_name("body")
+                if body is not None:
+                    ranges.append((body.start_byte, body.end_byte))
+            elif child.type in _HOLDERS:
+                stack.append(child)
+    return ranges
 
 
 def deeper_than(root: Node, limit: int) -> bool:

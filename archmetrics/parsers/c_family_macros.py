@@ -31,6 +31,13 @@ _BUILTIN = (
     rb"(?:(?:const|volatile|unsigned|signed)\s++)*+(?:void|char|short|int|long|float|double"
     rb"|bool|_Bool|size_t|ssize_t|u?int(?:8|16|32|64|ptr|max)_t|struct|enum|union)\b"
 )
+_LEADING = (
+    rb"(?:static|extern|inline|constexpr|consteval|constinit|virtual|explicit|friend|typedef"
+    rb"|template|const|volatile|unsigned|signed|void|bool|char|short|int|long|float|double"
+    rb"|struct|class|union|enum|auto)\b"
+)
+_WORD = rb"[^;{}()=\s/]++"  # a word of a declaration's type: no comment, no statement
+_STATEMENT = rb"(?:return|else|case|goto|throw|co_return|co_yield|new|delete|sizeof|typename)\b"
 _QUALIFIERS = rb"(?:\s*+(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*+"
 
 
@@ -50,51 +57,111 @@ def _attribute(names: Sequence[str]) -> bytes:
     return rb"(?:" + _MACRO + (rb"|" + listed if listed else b"") + rb")\b"
 
 
-Rule = tuple[re.Pattern[bytes], bool, bool]
-"""(pattern whose matching group is blanked, applies between declarations only, applies before the
-first parse: a misreading that gives tree-sitter no error, as a class named after its macro)."""
+@dataclass(frozen=True, slots=True)
+class Rule:
+    """Where a macro stands that tree-sitter cannot read: ``patterns`` (any of them) match
+    it, their last matching group is what is blanked. ``between``: only between
+    declarations; ``before``: before the first parse (a misreading that gives tree-sitter
+    no error, as a class named after its macro); ``word``: the match must not follow a
+    word character; ``alone``: the macro stands alone on its line (not an enumerator or an
+    operand, ``_standalone``); ``types``: the group's built-in type words are rewritten as
+    one identifier, not blanked.
+
+    Each pattern begins with a literal (a keyword, a bracket, a newline) wherever the rule
+    allows: Python's ``re`` then jumps from one occurrence of it to the next instead of
+    trying the pattern at every byte, five to ten times faster over a file."""
+
+    patterns: tuple[re.Pattern[bytes], ...]
+    between: bool = False
+    before: bool = False
+    word: bool = False
+    alone: bool = False
+    types: bool = False
+
+
+def _keywords(words: tuple[bytes, ...], rest: bytes) -> tuple[re.Pattern[bytes], ...]:
+    """One pattern per keyword (or punctuation), each starting with its literal; a keyword's
+    start is checked in code (``Rule.word``): a look-behind would cost the literal start."""
+    return tuple(re.compile(word + rest) for word in words)
+
+
+def _at_line_start(rest: bytes) -> tuple[re.Pattern[bytes], ...]:
+    """``rest`` at the start of a line: after a newline, or at the start of the file."""
+    return re.compile(rb"\n" + rest), re.compile(rb"\A" + rest)
 
 
 def _rules(names: MacroNames) -> tuple[Rule, ...]:
     macro = _attribute(names.attribute)
+    line_end = rb"[ \t]*+(?://[^\n]*+)?(?=\n|\Z)"
     return (
         # class FOO_EXPORT Name : / {     struct PACKED Name {     class LOCKABLE(x) Name
+        # class LOCKABLE WARN_UNUSED Name {   (the name is the last word before `:` `{`)
         # or, in group 2: class Name PROTOBUF_FINAL : Base {       (one pass for both)
-        (re.compile(rb"\b(?:class|struct|union)\s++(?:(" + macro + _ARGS + rb"?+)\s++(?="
-                    + _NAME + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))|" + _NAME
-                    + rb"\s++(?!final\b)(" + macro + _ARGS + rb"?+)(?=\s*(?::(?!:)|\{)))"),
-         False, True),
+        Rule(_keywords((b"class", b"struct", b"union"), rb"\s++(?:((?:(?>" + macro + _ARGS
+                       + rb"?+)\s++)+)(?=" + _NAME
+                       + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))|" + _NAME
+                       + rb"\s++(?!final\b)(" + macro + _ARGS
+                       + rb"?+)(?=\s*(?::(?!:)|\{)))"), before=True, word=True),
         # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT
-        (re.compile(rb"(?m)^[ \t]*(" + macro + rb")[ \t]*(?://[^\n]*)?$"), False, False),
+        Rule(_at_line_start(rb"[ \t]*+(" + macro + rb")" + line_end), alone=True),
         # void Lock() EXCLUSIVE_LOCKS_REQUIRED(mu_);   int f() const OVERRIDE {
-        (re.compile(rb"\)" + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS + rb"?+\s*+)++)"
-                    + rb"(?=;|\{|=[^=]|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"),
-         True, False),
+        Rule((re.compile(rb"\)" + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS + rb"?+\s*+)++)"
+                         + rb"(?=;|\{|=[^=]|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"),),
+             between=True),
         # a macro call alone on its line, not heading a body: RAPIDJSON_DIAG_OFF(effc++)
-        (re.compile(rb"(?m)^[ \t]*(" + macro + _ARGS + rb")[ \t]*(?://[^\n]*)?$(?!\s*[{:,.=])"),
-         True, False),
+        Rule(_at_line_start(rb"[ \t]*+(" + macro + _ARGS + rb")" + line_end
+                            + rb"(?!\s*[{:,.=])"), between=True, alone=True),
         # if EQ("a") {   while NOT_DONE(x) {
-        (re.compile(rb"\b(?:if|while|switch)\s+(?!constexpr\b)(" + _NAME + rb")(?=\s*\()"), False,
-         False),
+        Rule(_keywords((b"if", b"while", b"switch"), rb"\s+(?!constexpr\b)(" + _NAME
+                       + rb")(?=\s*\()"), word=True),
         # static BROTLI_INLINE void f(   static CYTHON_INLINE int g(   (a built-in type follows)
-        (re.compile(rb"\b(?:static|extern|inline)\s++(" + macro + rb")(?=\s++" + _BUILTIN + rb")"),
-         True, False),
+        Rule(_keywords((b"static", b"extern", b"inline"), rb"\s++(" + macro + rb")(?=\s++"
+                       + _BUILTIN + rb")"), between=True, word=True),
         # void f(int * BROTLI_RESTRICT self, ...)   (between a `*` and a parameter's name)
-        (re.compile(rb"\*\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"), False, False),
+        Rule((re.compile(rb"\*\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"),)),
+        # ABSL_CONST_INIT static T x;   ABSL_MUST_USE_RESULT inline int f(   (macros heading
+        # a declaration, before a keyword that begins one)
+        Rule(_at_line_start(rb"[ \t]*+((?>" + macro + _ARGS + rb"?+[ \t]++)++)(?=" + _LEADING
+                            + rb")"), between=True),
+        # bool done_ ABSL_GUARDED_BY(mu_) = false;    (a macro call after a declared name;
+        # the type and the name on one line, read a word at a time)
+        Rule(_at_line_start(rb"[ \t]*+(?>" + _WORD + rb"[ \t]++)*?" + _WORD
+                            + rb"(?<=[\w>*&])[ \t]++(?!" + _LEADING + rb"|" + _STATEMENT
+                            + rb")[A-Za-z_]\w*+\s++(" + macro + _ARGS
+                            + rb"(?>\s*+" + macro + _ARGS + rb")*+)(?=\s*+(?:;|=[^=]))"),
+             between=True),
+        # [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { ... }   (after a lambda's parameters)
+        Rule((re.compile(rb"\]\s*+" + _ARGS + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS
+                         + rb"?+\s*+)++)(?=\{|->|mutable\b|noexcept\b)"),)),
         # ABSL_FLAG(int, name, 0, "help");  a type among a macro call's arguments: the type's
-        # words (not blanked: rewritten as one identifier of the same length) in group 1
-        (re.compile(rb"(?m)^[ \t]*+" + macro + rb"(" + _ARGS + rb")"), True, False),
+        # words (not blanked: rewritten as one identifier of the same length) in group 1;
+        # in a body too: ASSERT_HEX(unsigned short, 2badU);
+        Rule(_at_line_start(rb"[ \t]*+" + macro + rb"(" + _ARGS + rb")"), types=True),
+        # EXPECT_EQ(WS WS WS, f(x))   (string macros side by side, no literal among them:
+        # all but the first blanked, the argument stays one expression)
+        Rule(_keywords((rb"\(", b","), rb"\s*+" + macro + rb"((?:\s++" + macro
+                       + rb")++)(?=\s*+[,)\"])")),
+        # for (; const char* p = next(s); ...)   (a declaration as a `for` condition, which
+        # tree-sitter-cpp's grammar lacks: its type blanked, an assignment is left)
+        Rule(_keywords((b"for",), rb"\s*+\(\s*+;\s*+((?:const\s++)?[A-Za-z_][\w:]*+(?:\s*+[*&]++"
+                                  rb"\s*+|\s++))(?=[A-Za-z_]\w*+\s*+=[^=])"), word=True),
+        # ABSL_INTERNAL_TRY {   (a macro alone before a block: a `try` or a scope, say)
+        Rule(_at_line_start(rb"[ \t]*+(" + macro + rb")[ \t]*+(?=\{)")),
     )  # fmt: skip
 
 
-_LINE_RULES = frozenset({1, 3})  # the rules for a macro alone on its line
-_TYPE_RULES = frozenset({7})  # the rule that rewrites types among a call's arguments
+# A built-in type that is a whole argument: after `(` or `,`, before `,` or `)`, so never a
+# part of one: `int[2]`, `int&`, `<int>` or `sizeof(long) * 2` inside an argument stay as
+# written; `sizeof(int)` becomes `sizeof(___)`, which reads alike.
 _TYPE_WORDS = re.compile(
-    rb"\b(?:(?:unsigned|signed|const|volatile|long|short)\s++)*+(?:bool|char|short|int|long"
-    rb"|float|double|void|unsigned|signed|size_t|u?int(?:8|16|32|64)_t)\b(?!\s*+\()"
+    rb"(?<=[(,])(\s*+)((?:(?:unsigned|signed|const|volatile|long|short)\s++)*+(?:bool|char"
+    rb"|short|int|long|float|double|void|unsigned|signed|size_t|u?int(?:8|16|32|64)_t))\b"
+    rb"(?=\s*+[,)])"
 )
 
 _RULES: dict[MacroNames, tuple[Rule, ...]] = {}
+_WORD_BYTE = [chr(byte).isalnum() or byte == ord("_") for byte in range(128)] + [True] * 128
+_LOOK_AHEAD = 4096  # bytes past a span of ``near`` a rule may read to decide a match in it
 # A literal or comment left open runs to the end of its line (strings) or of the file (raw
 # strings, block comments), as a compiler would read on: every byte is scanned once, never
 # once per quote or `/*` that follows (a file of 100,000 `/*` took minutes).
@@ -131,6 +198,19 @@ class _Ranges:
         return index >= 0 and offset < self._spans[index][1]
 
 
+# A directive and its continuation lines (`#define F(x) \` ... ): tree-sitter reads them
+# itself, and an `#if`'s condition is no `if EQ(...)`.
+_DIRECTIVE = _at_line_start(rb"[ \t]*+\#(?:[^\\\n]++|\\(?:\r?\n|.))*+")
+
+
+def directive_spans(data: bytes) -> _Ranges:
+    """The byte ranges of ``data``'s preprocessor directives, continuation lines included."""
+    after_newline, at_start = _DIRECTIVE
+    first = at_start.match(data)
+    spans = [first.span()] if first else []
+    return _Ranges(spans + [found.span() for found in after_newline.finditer(data)])
+
+
 def literal_spans(data: bytes) -> _Ranges:
     """The byte ranges of ``data``'s string and character literals and comments."""
     return _Ranges([found.span() for found in _LITERALS.finditer(data)])
@@ -141,32 +221,49 @@ def blank_macros(
     bodies: Iterable[tuple[int, int]] = (),
     names: MacroNames = MacroNames(),
     first: bool = False,
+    near: Iterable[tuple[int, int]] | None = None,
 ) -> bytes:
     """``data`` with the macros the rules recognise overwritten by spaces. ``bodies``: the
     byte ranges of function bodies (rules marked *between declarations* skip them);
-    ``first``: only the rules that run before the first parse."""
+    ``first``: only the rules that run before the first parse; ``near``: if given, only
+    the macros that start inside these byte ranges (disjoint) are blanked."""
     rules = _RULES.get(names)
     if rules is None:
         rules = _RULES.setdefault(names, _rules(names))
+    spans = [(0, len(data))] if near is None else list(near)
     hits = [
-        (number, found, between)
-        for number, (pattern, between, before) in enumerate(rules)
-        if before or not first
-        for found in pattern.finditer(data)
+        (rule, found)
+        for rule in rules
+        if rule.before or not first
+        for pattern in rule.patterns
+        for start, end in spans
+        # a match that starts in the span may look ahead past its end, a little
+        for found in pattern.finditer(data, start, min(len(data), end + _LOOK_AHEAD))
+        if found.start() < end
+        and not (rule.word and found.start() and _WORD_BYTE[data[found.start() - 1]])
     ]
     if not hits:
         return data
     in_body = _Ranges(list(bodies))
+    wanted = _Ranges(spans) if near is not None else None
     literal = literal_spans(data)
+    directive = directive_spans(data)
     out = bytearray(data)
-    for number, found, between in hits:
+    for rule, found in hits:
         start, end = found.span(found.lastindex or 1)  # the group that matched
-        if start in literal or (between and start in in_body):
+        if start in literal or (rule.between and start in in_body):
             continue
-        if number in _LINE_RULES and not _standalone(data, found.start()):
+        if wanted is not None and start not in wanted:
             continue
-        if number in _TYPE_RULES:
-            out[start:end] = _TYPE_WORDS.sub(lambda m: b"_" * len(m[0]), bytes(out[start:end]))
+        first = found.start() + (data[found.start() : found.start() + 1] == b"\n")
+        if start in directive or first in directive:  # where the match or its group starts
+            continue
+        if rule.alone and not _standalone(data, start):
+            continue
+        if rule.types:
+            out[start:end] = _TYPE_WORDS.sub(
+                lambda m: m[1] + b"_" * len(m[2]), bytes(out[start:end])
+            )
             continue
         blank(out, start, end)
     return bytes(out)

@@ -35,15 +35,19 @@ class Layout:
         found: dict[str, list[Node]],
         data: bytes,
         set_aside: Sequence[tuple[int, int]] = (),
+        within: tuple[int, int] | None = None,
     ) -> None:
         """``data``: the bytes as written; ``set_aside``: byte ranges this parse did not
-        read (#if branches its spelling blanked)."""
+        read (#if branches its spelling blanked); ``within``: only the nodes that overlap
+        these bytes are wanted (no other can cross a region inside them)."""
         self.data = data
+        low, high = within if within is not None else (0, len(data) + 1)
         nodes = sorted(
             {
-                (node.start_byte, -node.end_byte, node.type)
+                (start, -end, node.type)
                 for name in STRUCTURE
                 for node in found.get(name, [])
+                if (end := node.end_byte) > low and (start := node.start_byte) < high
             }
         )
         self.starts = [start for start, _, _ in nodes]
@@ -63,11 +67,11 @@ class Layout:
                 errors.append((node.start_byte, node.end_byte))
         self.errors = errors
         self.missing = sorted(node.start_byte for node in found.get("missing", []))
-        self.broken = _union(
+        self.broken = joined(
             [whole_lines(data, s, e) for s, e in errors + [(m, m) for m in self.missing]]
         )
         self.set_aside = sorted(set_aside)
-        self.damaged = _union(errors + [_around(node) for node in found.get("missing", [])])
+        self.damaged = damaged(found, data, errors)
 
     def crossing(self, start: int, end: int) -> Iterator[tuple[int, int, str]]:
         """The nodes that overlap ``[start, end)`` without lying inside it."""
@@ -111,15 +115,39 @@ def _overlap(ranges: list[tuple[int, int]], start: int, end: int) -> int:
     return total
 
 
-def _union(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
+def joined(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
     """Sorted ranges, those that overlap or touch joined."""
-    joined: list[tuple[int, int]] = []
+    union: list[tuple[int, int]] = []
     for start, end in sorted(ranges):
-        if joined and start <= joined[-1][1]:
-            joined[-1] = (joined[-1][0], max(end, joined[-1][1]))
+        if union and start <= union[-1][1]:
+            union[-1] = (union[-1][0], max(end, union[-1][1]))
         else:
-            joined.append((start, end))
-    return joined
+            union.append((start, end))
+    return union
+
+
+def damaged(
+    found: dict[str, list[Node]], data: bytes, errors: list[tuple[int, int]] | None = None
+) -> list[tuple[int, int]]:
+    """The regions a parse damaged, sorted: its ``ERROR`` nodes and the nodes its invented
+    tokens complete, those at most a line apart joined. ``errors``: the ``ERROR`` spans,
+    if known."""
+    if errors is None:
+        errors = [(node.start_byte, node.end_byte) for node in found.get("error", [])]
+    return _close(joined(errors + [_around(node) for node in found.get("missing", [])]), data)
+
+
+def _close(ranges: list[tuple[int, int]], data: bytes) -> list[tuple[int, int]]:
+    """Sorted, disjoint ``ranges`` with those at most one line apart joined: what lies
+    between two broken lines belongs to the same damage (``#if A / -1 / #else / x / #endif``
+    broken at each directive leaves a line that reads as a statement only by chance)."""
+    closed: list[tuple[int, int]] = []
+    for start, end in ranges:
+        if closed and data.count(b"\n", closed[-1][1], start) <= 2:
+            closed[-1] = (closed[-1][0], end)
+        else:
+            closed.append((start, end))
+    return closed
 
 
 def _around(missing: Node) -> tuple[int, int]:

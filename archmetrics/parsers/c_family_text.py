@@ -167,7 +167,6 @@ def literal(kind: str, data: bytes) -> tuple[bool, Literal]:
     return False, None
 
 
-_CODE_LINE = re.compile(rb"^[ \t\f\v\r]*[^\s]", re.MULTILINE)
 _BLANK = bytes(byte if byte in b"\r\n" else 0x20 for byte in range(256))
 
 
@@ -198,19 +197,24 @@ def blank_comments(data: bytes, comments: Iterable[tuple[int, int]]) -> bytes:
 
 def sloc(clean: bytes) -> int:
     """Physical lines holding at least one character that is not blank (comments blanked)."""
-    return len(_CODE_LINE.findall(clean))
+    lines = clean.translate(None, b" \t\r\f\v").split(b"\n")
+    return len(lines) - lines.count(b"")
 
 
 # The tokenizer for many statements at once: separated by NUL, which only `\S` may match.
+# White space is skipped by one possessive run and the commonest tokens come first (words,
+# then brackets and separators): the alternatives are tried at token starts only.
 _BATCH_TOKEN = re.compile(
-    rb"\d(?:[eEpP][-+]|'?[\w.])*"
-    rb"""|\w+(?:"(?:\\[^\0]|[^"\\\n\0])*"?|'(?:\\[^\0]|[^'\\\n\0])*'?)?"""
-    rb'|"(?:\\[^\0]|[^"\\\n\0])*"?'
-    rb"|'(?:\\[^\0]|[^'\\\n\0])*'?"
-    rb"|\#[ \t]*\w+"
-    rb"|\.\d(?:[eEpP][-+]|'?[\w.])*"
+    rb"\s*+("
+    rb"""[^\W\d]\w*+(?:"(?:\\[^\0]|[^"\\\n\0])*+"?|'(?:\\[^\0]|[^'\\\n\0])*+'?)?"""
+    rb"|[(),;{}\[\]]"
+    rb"|\d(?:[eEpP][-+]|'?[\w.])*+"
+    rb'|"(?:\\[^\0]|[^"\\\n\0])*+"?'
+    rb"|'(?:\\[^\0]|[^'\\\n\0])*+'?"
+    rb"|\#[ \t]*+\w+"
+    rb"|\.\d(?:[eEpP][-+]|'?[\w.])*+"
     rb"|->\*|<<=|>>=|<=>|\.\.\.|::|->|\+\+|--|<<|>>|<=|>=|==|!=|&&|\|\||[-+*/%&|^]=|\#\#|\.\*"
-    rb"|\S"
+    rb"|\S)"
 )
 
 

@@ -123,6 +123,13 @@ DECISIONS: Mapping[str, str] = {
     "#elifndef": "#elifndef",
 }
 
+#: A `catch` clause cut from its `try` by an #if (`} catch (A&) {} / #ifdef X / catch (B&)
+#: {} / #endif`): tree-sitter reads a function named `catch`; in a body it is the clause.
+CATCH_READ_AS_FUNCTION = (
+    "(function_definition declarator: (function_declarator declarator: (identifier)"
+    ' @catch (#eq? @catch "catch")))'
+)
+
 #: `&&` tokens that are rvalue references, not logical and.
 NOT_DECISIONS = (
     '(reference_declarator "&&" @nodecision)',

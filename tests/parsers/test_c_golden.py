@@ -344,6 +344,18 @@ def test_ifndef_in_a_body_counts_unlike_lizard() -> None:
     assert [d.kind for d in c(source).functions[0].decisions] == ["#ifndef"]
 
 
+def test_and_before_an_assignment_counts_unlike_lizard() -> None:
+    """Disagreement class 5: lizard takes a `&&` followed by a lone `=` (before any of
+    `;{})`) for an rvalue reference `T&& x = ...` and does not count it; it is a logical
+    and."""
+    import lizard
+
+    source = "void f(T *t) {\n  while (t && (x = next(t)) != 0)\n    g(x);\n}\n"
+    assert [d.kind for d in c(source).functions[0].decisions] == ["while", "&&"]
+    (theirs,) = lizard.analyze_file.analyze_source_code("f.c", source).function_list
+    assert theirs.cyclomatic_complexity == 2  # the `&&` not counted
+
+
 def test_preprocessor_conditionals_outside_functions_are_no_decisions() -> None:
     facts = c("#if A && B\nint f(void) { return 0; }\n#endif\n")
     assert complexities(facts) == {"f": 1}

@@ -488,3 +488,226 @@ def test_a_type_among_a_file_scope_macro_calls_arguments(language: str) -> None:
     ]
     assert [site.name for site in facts.call_sites] == ["ABSL_FLAG", "ABSL_FLAG"]
     assert not lost(facts)
+
+
+# --- found on real code since (psutil, abseil, grpc, gevent) -------------------------------
+
+
+@LANGUAGES
+def test_a_return_type_in_capitals_on_its_own_line_is_kept(language: str) -> None:
+    # psutil: `PVOID` above the name is a type; the broken spot is a macro 25 lines below
+    facts = facts_of(
+        """
+        PVOID
+        get_proc(LPCSTR name) {
+            return lookup(name);
+        }
+        PVOID
+        get_lib_proc(LPCSTR lib, LPCSTR name) {
+            HMODULE mod;
+            Py_BEGIN_ALLOW_THREADS
+            mod = LoadLibraryA(lib);
+            Py_END_ALLOW_THREADS
+            if (mod == NULL) {
+                return NULL;
+            }
+            return find(mod, name) ? mod : NULL;
+        }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"get_proc": 1, "get_lib_proc": 3}
+    assert spans(facts) == {"get_proc": (2, 5), "get_lib_proc": (6, 16)}
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_a_directive_line_is_never_rewritten(language: str) -> None:
+    # `#if defined(A) || ...` is no `if EQ(...)`: its `||` is not a decision (lizard alike)
+    facts = facts_of(
+        """
+        int users(void) {
+            t = Py_BuildValue(
+                "(Oi)",
+                name,
+        #if defined(OPENBSD) || (defined(FREEBSD) && V < 900000)
+                -1
+        #else
+                ut.ut_pid
+        #endif
+                );
+            if (!t) return 1;
+            return 0;
+        }
+        """,
+        language,
+    )
+    assert [d.kind for d in facts.functions[0].decisions] == ["#if", "if"]
+    assert not lost(facts)
+
+
+def test_a_spelling_reads_one_branch_only_of_the_groups_it_is_told_to() -> None:
+    # psutil: a call's arguments spelled per platform need one branch; an `if` in another
+    # group of the same function, which the every-branch reading reads well, must stay
+    from archmetrics.parsers.c_family_branches import Conditionals
+
+    data = b"#ifdef A\nx;\n#else\ny;\n#endif\n#ifdef B\nz;\n#else\nw;\n#endif\n"
+    conditionals = Conditionals(data)
+    first, second = conditionals.groups
+    spelling = conditionals.spelling(0, [first, second], only=[second])
+    assert [line.strip() for line in spelling.data.split(b"\n")] == [
+        b"", b"x;", b"", b"y;", b"", b"", b"z;", b"", b"", b"", b"",
+    ]  # fmt: skip
+    assert len(spelling.data) == len(data)
+    assert conditionals.spelling(0, [first, second]).data.count(b";") == 2
+
+
+def test_macros_heading_a_declaration_and_annotating_a_member_or_a_lambda() -> None:
+    # abseil and grpc: `ABSL_CONST_INIT static`, `x_ ABSL_GUARDED_BY(mu_)` (also on the next
+    # line), `[&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {`
+    facts = facts_of(
+        """
+        namespace absl {
+        ABSL_CONST_INIT static Options options;
+        ABSL_ATTRIBUTE_NOINLINE static void Write(int fd) { if (fd) w(fd); }
+        class Entry {
+          bool done_ ABSL_GUARDED_BY(&Lb::mu_) = false;
+          std::vector<RefCountedPtr<Wrapper>> wrappers_
+              ABSL_GUARDED_BY(&Lb::mu_);
+          void Update() {
+            bool changed = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(&Lb::mu_) {
+              if (wrappers_.size() != n) return true;
+              return false;
+            }();
+            if (changed) Apply();
+          }
+        };
+        }  // namespace absl
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {"absl::Write": 2, "absl::Entry::Update": 3}
+    assert not lost(facts)
+
+
+def test_a_catch_clause_behind_an_ifdef_counts() -> None:
+    # abseil: tree-sitter reads the lone clause as a function named `catch`
+    facts = facts_of(
+        """
+        void f() {
+          try {
+            g();
+          } catch (const std::bad_function_call&) {
+          }
+        #ifdef _LIBCPP_VERSION
+          catch (const std::exception&) {
+            h();
+          }
+        #endif
+        }
+        """,
+        "cpp",
+    )
+    assert [d.kind for d in facts.functions[0].decisions] == ["catch", "#ifdef", "catch"]
+    assert [f.name for f in facts.functions] == ["f"]
+
+
+# --- a rereading is judged without a query ---------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        "int f() { if (x) { return 1; }\nint g() { @ }\n",  # an ERROR and a missing `}`
+        "class FOO_EXPORT A : B { int f() const { return 1 } };\n",  # a missing `;`
+        "@@@ \\\\ $$$\n",  # nothing readable: the root itself is the ERROR
+        "namespace n { int a = 1 int b; void f(int x) { g(x) } }\n",
+        "struct S { int x; };\nint ok(void) { return 0; }\n",  # no error at all
+    ],
+)
+def test_errors_and_missing_tokens_are_what_the_query_captures(source: str) -> None:
+    from tree_sitter import QueryCursor
+
+    from archmetrics.parsers.c_family_grammar import errors_and_missing, grammar
+
+    for language in ("c", "cpp"):
+        built = grammar(language)
+        root = built.parser.parse(source.encode()).root_node
+        captured = QueryCursor(built.query).captures(root)
+        found = errors_and_missing(root)
+        for name in ("error", "missing"):
+            assert sorted((n.start_byte, n.end_byte, n.type) for n in found[name]) == sorted(
+                (n.start_byte, n.end_byte, n.type) for n in captured.get(name, [])
+            ), (language, name)
+
+
+def test_two_macros_between_class_and_its_name() -> None:
+    # abseil's SpinLock; a name in capitals after a macro is still the name
+    facts = facts_of(
+        """
+        class ABSL_LOCKABLE ABSL_ATTRIBUTE_WARN_UNUSED SpinLock {
+         public:
+          SpinLock() : word_(0) { if (x) y(); }
+        };
+        class FOO_EXPORT MY_CLASS { int f() { return 1; } };
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {"SpinLock::SpinLock": 2, "MY_CLASS::f": 1}
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_macros_inside_a_body_a_type_argument_a_try_macro_and_string_macros(
+    language: str,
+) -> None:
+    # re2's ASSERT_HEX(unsigned short, 2badU); abseil's ABSL_INTERNAL_TRY {;
+    # sentencepiece's EXPECT_EQ(WS WS WS, ...) with `#define WS "\xe2\x96\x81"`
+    facts = facts_of(
+        """
+        void hex(void) {
+          ASSERT_HEX(short, 2bad);
+          ASSERT_HEX(unsigned short, 2badU);
+          if (a) b();
+        }
+        void range(int *p) {
+          for (int i = 0; i < 3; ++i) {
+            ABSL_INTERNAL_TRY {
+              build(p + i);
+            }
+            ABSL_INTERNAL_CATCH_ANY {
+              undo(p, i);
+            }
+          }
+        }
+        void ws(void) {
+          EXPECT_EQ(WS WS WS, normalize("   "));
+          EXPECT_EQ(WS WS "a" WS, normalize("  a "));
+          if (x) y();
+        }
+        int after(int a) { return a ? 1 : 0; }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"hex": 2, "range": 2, "ws": 2, "after": 2}
+    assert [s.name for s in facts.call_sites if s.name.startswith("ASSERT")] == ["ASSERT_HEX"] * 2
+    assert not lost(facts)
+
+
+def test_a_declaration_as_a_for_condition() -> None:
+    # abseil's cctz: valid C++ that tree-sitter-cpp's grammar does not know; the functions
+    # after it were one ERROR before
+    facts = facts_of(
+        """
+        const char* ParseInt(const char* p) {
+          for (; const char* dp = strchr(kDigits, *p); p += 1) {
+            if (dp == nullptr) break;
+          }
+          return p;
+        }
+        int after(int a) { return a ? 1 : 0; }
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {"ParseInt": 3, "after": 2}
+    assert not lost(facts)

@@ -140,8 +140,11 @@ def _keyed(functions: Iterator[tuple[int, object]]) -> dict[int, object]:
 
 _NOT_IN_LIZARD = {"#ifndef", "#elifdef", "#elifndef"}
 _AND_OR = re.compile(r"\b(and|or)\b")
-_RVALUE = re.compile(r"&&\s*(\w+\s*[:),]|>)")
+_RVALUE = re.compile(r"&&\s*(\w+\s*[:),]|[>),.{;]|noexcept\b|const\b)")
 _TRY_BLOCK = re.compile(r"\)\s*(const\s*)?try\s*\{")
+# lizard's rvalue-reference heuristic: a `&&` followed by a lone `=` before any of `;{})`
+# is taken for `T&& x = ...` and not counted (`while (t && (x = next(t)) != 0)`)
+_ASSIGNING_AND = re.compile(r"&&(?:[<>!=]=|[^=;{})])*?(?<![<>!=+\-*/%&|^])=(?!=)")
 
 
 def _disagreement_class(source_lines: list[str], ours: Function, expected: int) -> str:
@@ -156,6 +159,9 @@ def _disagreement_class(source_lines: list[str], ours: Function, expected: int) 
     )
     if delta > 0 and delta == ifndef + and_or:
         return "1/2: #ifndef-like directive or and/or keyword (we count, lizard does not)"
+    assigning = len(_ASSIGNING_AND.findall(body))
+    if delta > 0 and assigning and delta == ifndef + and_or + assigning:
+        return "5: && before an assignment (lizard takes it for T&& x = ...)"
     if delta < 0 and _RVALUE.search(body):
         return "3: rvalue reference && (lizard counts it)"
     if _TRY_BLOCK.search(body):
