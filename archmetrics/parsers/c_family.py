@@ -137,26 +137,25 @@ class Reading:
                 " off (raise limits.parse-seconds, ParseLimits.parse_seconds, to measure it)"
             )
         root = tree.root_node
-        depth = min(limits.max_depth, QUERY_DEPTH)
-        if deeper_than(root, depth):
-            return f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
-                "the limit is limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
-                if depth == limits.max_depth
-                else "tree-sitter's query cannot go deeper"
-            )
-        if damage_only and root.has_error:
+        if damage_only and root.has_error:  # found without a query: any depth is safe
             found = errors_and_missing(root)
             return cls(data, tree, found, _damage(found), complete=False)
+        problem = _too_deep(root, limits)
+        if problem is not None:
+            return problem
         cursor = QueryCursor(built.query)
         if within is not None:
             cursor.set_byte_range(*within)
         found = cursor.captures(root)
         return cls(data, tree, found, _damage(found))
 
-    def completed(self, built: Grammar) -> Reading:
-        """This reading with every capture of the full query."""
+    def completed(self, built: Grammar, limits: ParseLimits) -> Reading | str:
+        """This reading with every capture of the full query, or why there is none."""
         if self.complete:
             return self
+        problem = _too_deep(self.root, limits)
+        if problem is not None:
+            return problem
         found = QueryCursor(built.query).captures(self.root)
         return Reading(self.data, self.tree, found, _damage(found))
 
@@ -174,6 +173,18 @@ class Reading:
             if body is not None:
                 ranges.append((body.start_byte, body.end_byte))
         return ranges
+
+
+def _too_deep(root: Node, limits: ParseLimits) -> str | None:
+    """Why the query may not walk this tree (it is too deep), or None."""
+    depth = min(limits.max_depth, QUERY_DEPTH)
+    if not deeper_than(root, depth):
+        return None
+    return f"tree-sitter's tree of this file is more than {depth:,} levels deep; " + (
+        "the limit is limits.nesting, ParseLimits.max_depth (raise it to measure the file)"
+        if depth == limits.max_depth
+        else "tree-sitter's query cannot go deeper"
+    )
 
 
 def _damage(found: dict[str, list[Node]]) -> tuple[int, int]:
@@ -214,17 +225,20 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
         return not_measured(path, str(language), 1, reading)
     if reading.root.has_error:
         reading = _recover(built, reading, limits)
+        if isinstance(reading, str):
+            return not_measured(path, str(language), 1, reading)
     composite = _branches(built, reading, limits) if reading.root.has_error else None
     reading_used = composite or Composite.of(reading)
     return _facts(path, language, built, reading_used, data, limits.c_macros)
 
 
-def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
+def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading | str:
     """The first parse had errors: parse again with the macros tree-sitter cannot know
     blanked (c_family_macros.py), first only those near the damage, then (if damage is
     left) all of them, and keep whichever parse lost least. Blanking only near the damage
     keeps a macro-like word that was read well elsewhere (a return type ``PVOID`` alone on
-    its line above a function's name)."""
+    its line above a function's name). The depth limit is checked on the reading kept
+    (the query walks it; the rereadings are judged without one)."""
     bodies = reading.bodies()
     damage = damaged(reading.found, reading.data)
     near = [_around(reading.data, [span], _SUSPECT_LINES) for span in damage]
@@ -239,7 +253,10 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading:
         other = Reading.of(built, blanked, limits, reading, damage_only=True)
         if not isinstance(other, str) and other.damage < best.damage:
             best = other
-    return best.completed(built)
+    completed = best.completed(built, limits)
+    if isinstance(completed, str) and best is not reading:  # too deep: the first reading
+        return reading.completed(built, limits)
+    return completed
 
 
 def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composite | None:

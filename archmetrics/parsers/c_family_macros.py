@@ -255,8 +255,8 @@ def blank_macros(
             continue
         if wanted is not None and start not in wanted:
             continue
-        first = found.start() + (data[found.start() : found.start() + 1] == b"\n")
-        if start in directive or first in directive:  # where the match or its group starts
+        begins = found.start() + (data[found.start() : found.start() + 1] == b"\n")
+        if start in directive or begins in directive:  # where the match or its group starts
             continue
         if rule.alone and not _standalone(data, start):
             continue
