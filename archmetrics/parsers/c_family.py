@@ -241,7 +241,7 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading |
     (the query walks it; the rereadings are judged without one)."""
     bodies = reading.bodies()
     damage = damaged(reading.found, reading.data)
-    near = [_around(reading.data, [span], _SUSPECT_LINES) for span in damage]
+    near = _nearby(reading.data, damage)
     best, tried = reading, {reading.data}
     for spans in (joined(near), None):
         if spans is None and best.damage == (0, 0):
@@ -315,9 +315,8 @@ _SUSPECT_LINES = 3  # an #if group this near a damaged region may be its cause
 def _suspects(data: bytes, base: Layout) -> list[tuple[int, int]]:
     """Where an #if directive may have caused the damage: each damaged region of ``base``
     with ``_SUSPECT_LINES`` lines either side, and the function definition around it."""
-    spans = []
+    spans = _nearby(data, base.damaged)
     for start, end in base.damaged:
-        spans.append(_around(data, [(start, end)], _SUSPECT_LINES))
         spans.extend(
             (s, e) for s, e, kind in base.crossing(start, end) if kind == c_tables.FUNCTION
         )
@@ -329,9 +328,14 @@ def _still_damaged(data: bytes, groups: list[Group], every: Layout) -> list[Grou
     kept (``every``): only they need reading one branch at a time (None: all of them)."""
     if not every.damaged:
         return None
-    near = [_around(data, [span], _SUSPECT_LINES) for span in every.damaged]
-    chosen = Conditionals.near_in(groups, near)
+    chosen = Conditionals.near_in(groups, _nearby(data, every.damaged))
     return chosen or None
+
+
+def _nearby(data: bytes, damaged: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """Each damaged span with ``_SUSPECT_LINES`` lines either side: where its cause (a
+    macro, an #if directive) may stand."""
+    return [_around(data, [span], _SUSPECT_LINES) for span in damaged]
 
 
 def _around(data: bytes, damaged: list[tuple[int, int]], lines: int) -> tuple[int, int]:
