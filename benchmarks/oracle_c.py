@@ -42,6 +42,8 @@ CORPORA: dict[str, tuple[str, tuple[str, ...]]] = {
     "ujson": ("ujson==5.10.0", ("src", "deps")),
     "pycryptodome": ("pycryptodome==3.21.0", ("src",)),
     "uvloop": ("uvloop==0.21.0", ("vendor/libuv/src", "vendor/libuv/include")),
+    "numpy": ("numpy==2.2.0", ("numpy/_core/src", "numpy/_core/include", "numpy/fft",
+                               "numpy/linalg", "numpy/random/src")),
 }  # fmt: skip
 SUFFIXES = {".c": Language.C, ".h": Language.CPP, ".cc": Language.CPP, ".cpp": Language.CPP,
             ".hpp": Language.CPP, ".cxx": Language.CPP, ".hh": Language.CPP}  # fmt: skip

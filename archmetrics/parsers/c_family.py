@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import bisect
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from tree_sitter import Node, QueryCursor, Tree
@@ -33,6 +34,7 @@ from archmetrics.parsers.c_family_grammar import (
     errors_and_missing,
     function_bodies,
     grammar,
+    missing_parents,
     syntax_tree,
 )
 from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
@@ -121,14 +123,14 @@ class Reading:
         data: bytes,
         limits: ParseLimits,
         like: Reading | None = None,
-        within: tuple[int, int] | None = None,
+        within: Sequence[tuple[int, int]] | None = None,
         damage_only: bool = False,
     ) -> Reading | str:
         """The reading of ``data``, or why there is none (a limit). ``like``: a reading of
         the same file with other spans blanked, whose tree the parse reuses; ``within``:
-        only the captures that overlap these bytes are wanted; ``damage_only``: if the
-        parse has errors, only they and the tokens it invented are found (``completed``
-        takes the captures; a clean parse is captured at once)."""
+        only the captures that overlap these byte ranges (sorted, disjoint) are wanted;
+        ``damage_only``: if the parse has errors, only they and the tokens it invented are
+        found (``completed`` takes the captures; a clean parse is captured at once)."""
         old = (like.tree, like.data) if like is not None else None
         tree = syntax_tree(built.parser, data, limits.parse_seconds, old)
         if tree is None:
@@ -143,10 +145,10 @@ class Reading:
         problem = _too_deep(root, limits)
         if problem is not None:
             return problem
-        cursor = QueryCursor(built.query)
-        if within is not None:
-            cursor.set_byte_range(*within)
-        found = cursor.captures(root)
+        if within is None:
+            found = QueryCursor(built.query).captures(root)
+        else:
+            found = _captures_within(built, root, within)
         return cls(data, tree, found, _damage(found))
 
     def completed(self, built: Grammar, limits: ParseLimits) -> Reading | str:
@@ -173,6 +175,25 @@ class Reading:
             if body is not None:
                 ranges.append((body.start_byte, body.end_byte))
         return ranges
+
+
+def _captures_within(
+    built: Grammar, root: Node, within: Sequence[tuple[int, int]]
+) -> dict[str, list[Node]]:
+    """The query's captures that overlap one of the byte ranges ``within``, each once (a
+    node around two ranges, a namespace say, is captured in both)."""
+    found: dict[str, list[Node]] = {}
+    seen: set[tuple[str, int]] = set()
+    for start, end in within:
+        cursor = QueryCursor(built.query)
+        cursor.set_byte_range(start, end)
+        for name, nodes in cursor.captures(root).items():
+            kept = found.setdefault(name, [])
+            for node in nodes:
+                if (name, node.id) not in seen:
+                    seen.add((name, node.id))
+                    kept.append(node)
+    return found
 
 
 def _too_deep(root: Node, limits: ParseLimits) -> str | None:
@@ -240,11 +261,11 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading |
     its line above a function's name). The depth limit is checked on the reading kept
     (the query walks it; the rereadings are judged without one)."""
     bodies = reading.bodies()
-    damage = damaged(reading.found, reading.data)
+    damage = damaged(reading.found, reading.data, root=reading.root)
     near = _nearby(reading.data, damage)
     best, tried = reading, {reading.data}
     for spans in (joined(near), None):
-        if spans is None and best.damage == (0, 0):
+        if spans is None and not _widespread(best):
             break
         blanked = blank_macros(reading.data, bodies, limits.c_macros, near=spans)
         if blanked in tried:
@@ -259,19 +280,36 @@ def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading |
     return completed
 
 
+_FAR_LINES = 10  # a damaged region this long may come from a macro far from it
+
+
+def _widespread(reading: Reading) -> bool:
+    """Whether a damaged region of ``reading`` spans more than ``_FAR_LINES`` lines: a
+    macro that breaks a file's structure (``ABSL_NAMESPACE_BEGIN`` before a class) damages
+    what follows it, so its cause may lie outside the lines near the damage; a macro that
+    breaks one declaration damages only that, near it."""
+    data = reading.data
+    return any(
+        data.count(b"\n", s, e) > _FAR_LINES
+        for s, e in damaged(reading.found, data, root=reading.root)
+    )
+
+
 def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composite | None:
     """Where ``reading`` has errors, the file read again without its #if directives (every
     branch kept, then one branch at a time: c_family_branches.py), region by region."""
     conditionals = Conditionals(reading.data)
     if not conditionals.groups:
         return None
-    damage = damaged(reading.found, reading.data)
+    damage = damaged(reading.found, reading.data, root=reading.root)
     if not damage:
         return None
     # only the groups near the damage are read otherwise, and only the captures there are
-    # taken, unless a region grows past that window: then the whole file is read again
-    window: tuple[int, int] | None = _around(reading.data, damage, _CONTEXT_LINES)
-    base = Layout(reading.found, reading.data, within=window)
+    # taken, unless a region grows past those windows: then the whole file is read again
+    window: list[tuple[int, int]] | None = joined(
+        [_around(reading.data, [span], _CONTEXT_LINES) for span in damage]
+    )
+    base = Layout(reading.found, reading.data, within=window, root=reading.root)
     readings: list[Reading] = []
     layouts: list[Layout] = []
     found_in: list[list[tuple[int, str, int]]] = []  # the blanked directives' decisions
@@ -279,7 +317,7 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     groups = conditionals.near(_suspects(reading.data, base))
     if not groups:
         return None  # no #if near the damage: another spelling would read it alike
-    spellings = [ALL, *range(min(max(g.branches for g in groups), BRANCH_SPELLINGS))]
+    spellings = _spellings(groups)
     index = 0
     reduced: list[Group] | None = None  # the groups one branch at a time: near ALL's damage
     while index < len(spellings):
@@ -289,17 +327,18 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
         if isinstance(other, str):
             continue
         readings.append(other)
-        layouts.append(Layout(other.found, reading.data, spelling.set_aside))
+        layouts.append(Layout(other.found, reading.data, spelling.set_aside, root=other.root))
         if spellings[index - 1] == ALL:
             reduced = _still_damaged(reading.data, groups, layouts[-1])
+            if reduced is not None:  # one branch at a time only where it can read more
+                spellings = _spellings(reduced)
         found_in.append(spelling.decisions)
         choices = choose(base, layouts)
-        if window is not None and not all(
-            window[0] <= c.start and c.end <= window[1] for c in choices
-        ):
+        if window is not None and not all(_inside(window, c.start, c.end) for c in choices):
             window, index, readings, layouts, found_in = None, 0, [], [], []
             groups, reduced = conditionals.near(None), None
-            base = Layout(reading.found, reading.data)
+            spellings = _spellings(groups)
+            base = Layout(reading.found, reading.data, root=reading.root)
             continue
         if _all_read(base, layouts, choices):
             break
@@ -308,7 +347,21 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     return _merge(reading, readings, choices, found_in)
 
 
+def _spellings(groups: list[Group]) -> list[int]:
+    """Every branch kept (``ALL``), then the first, second... branch of each of ``groups``,
+    as many as the group with most branches has (at most ``BRANCH_SPELLINGS``)."""
+    return [ALL, *range(min(max((g.branches for g in groups), default=0), BRANCH_SPELLINGS))]
+
+
 _CONTEXT_LINES = 40  # lines either side of the damage whose captures a spelling takes
+
+
+def _inside(ranges: list[tuple[int, int]], start: int, end: int) -> bool:
+    """Whether ``[start, end)`` lies inside one of sorted, disjoint ``ranges``."""
+    index = bisect.bisect_right(ranges, start, key=lambda r: r[0]) - 1
+    return index >= 0 and ranges[index][0] <= start and end <= ranges[index][1]
+
+
 _SUSPECT_LINES = 3  # an #if group this near a damaged region may be its cause
 
 
@@ -325,11 +378,11 @@ def _suspects(data: bytes, base: Layout) -> list[tuple[int, int]]:
 
 def _still_damaged(data: bytes, groups: list[Group], every: Layout) -> list[Group] | None:
     """Of ``groups``, those with a directive near the damage left where every branch was
-    kept (``every``): only they need reading one branch at a time (None: all of them)."""
+    kept (``every``): only they need reading one branch at a time (none: no spelling of
+    one branch reads more; None: ``every`` left no damage, all of them)."""
     if not every.damaged:
         return None
-    chosen = Conditionals.near_in(groups, _nearby(data, every.damaged))
-    return chosen or None
+    return Conditionals.near_in(groups, _nearby(data, every.damaged))
 
 
 def _nearby(data: bytes, damaged: list[tuple[int, int]]) -> list[tuple[int, int]]:
@@ -400,8 +453,10 @@ def _facts(
     root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
+    missing = found.get("missing", [])
+    parents = missing_parents(root) if missing else {}
     made, explained = definitions(
-        in_order(found.get("stmt", [])), found.get("missing", []), data, macros.function
+        in_order(found.get("stmt", [])), missing, data, macros.function, parents
     )
     slots = _functions(made, data, scopes)
     owner = _Owners(slots)

@@ -18,6 +18,7 @@ from tree_sitter import Node
 
 from archmetrics.facts import Span
 from archmetrics.parsers import c_tables
+from archmetrics.parsers.c_family_grammar import Parents, parent_of
 from archmetrics.parsers.c_family_names import span
 
 #: Where a call-like head followed by a block is a definition, not a statement.
@@ -51,12 +52,17 @@ class Definition:
 
 
 def definitions(
-    statements: Iterable[Node], missing: Iterable[Node], data: bytes, macros: Iterable[str]
+    statements: Iterable[Node],
+    missing: Iterable[Node],
+    data: bytes,
+    macros: Iterable[str],
+    parents: Parents | None = None,
 ) -> tuple[list[Definition], list[Node]]:
     """The function definitions among ``statements``, and those made by macros (found from
     the ``;`` tokens tree-sitter had to invent, ``missing``); and the invented tokens that
     belong to a macro-made definition (not a loss to warn about). ``macros``: names the
-    configuration lists as function macros, recognised at any scope outside a function."""
+    configuration lists as function macros, recognised at any scope outside a function;
+    ``parents``: the invented tokens' parents, if known (``missing_parents``)."""
     found: list[Definition] = []
     for node in statements:
         if node.type == c_tables.FUNCTION:
@@ -76,7 +82,7 @@ def definitions(
     explained: list[Node] = []
     listed = frozenset(macros)
     for token in missing:
-        made = _macro_made(token, data, listed)
+        made = _macro_made(token, data, listed, parents or {})
         if made is not None:
             found.append(made)
             explained.append(token)
@@ -84,11 +90,13 @@ def definitions(
     return found, explained
 
 
-def _macro_made(token: Node, data: bytes, listed: frozenset[str]) -> Definition | None:
+def _macro_made(
+    token: Node, data: bytes, listed: frozenset[str], parents: Parents
+) -> Definition | None:
     """The definition ``NAME(args) { ... }`` whose head lacks the invented ``token``."""
     if token.type != ";":
         return None
-    head = token.parent  # a walk down from the root, once per invented token
+    head = parent_of(token, parents)
     if head is None or head.type != "expression_statement" or head.named_child_count != 1:
         return None
     call = head.named_child(0)

@@ -11,11 +11,11 @@ patterns here name parents only where they do not nest deeply.
 from __future__ import annotations
 
 import importlib
+import re
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-import numpy
 from tree_sitter import Language as TSLanguage
 from tree_sitter import Node, Parser, Point, Query, QueryError, Tree
 
@@ -127,26 +127,28 @@ _NEAR = 64  # differing spans closer than this are one edit
 
 def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
     """A copy of ``tree`` (of ``before``) told where ``after``, as long, differs from it."""
-    old = numpy.frombuffer(before, dtype=numpy.uint8)
-    new = numpy.frombuffer(after, dtype=numpy.uint8)
-    differ = numpy.flatnonzero(old != new)
+    size = len(before)
+    differ = (int.from_bytes(before, "big") ^ int.from_bytes(after, "big")).to_bytes(size, "big")
     copy = tree.copy()
-    if not len(differ):
-        return copy
-    breaks = numpy.flatnonzero(numpy.diff(differ) > _NEAR)
-    starts = numpy.concatenate(([differ[0]], differ[breaks + 1]))
-    ends = numpy.concatenate((differ[breaks], [differ[-1]])) + 1
-    newlines = numpy.flatnonzero(old == 10)
-
-    def point(offset: int) -> Point:
-        row = int(numpy.searchsorted(newlines, offset))
-        column = offset - (int(newlines[row - 1]) + 1 if row else 0)
-        return Point(row, column)
-
-    for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
-        begin, finish = point(start), point(end)
-        copy.edit(start, end, end, begin, finish, finish)
+    spans: list[list[int]] = []
+    for found in _DIFFERENT.finditer(differ):
+        if spans and found.start() - spans[-1][1] < _NEAR:
+            spans[-1][1] = found.end()
+        else:
+            spans.append([found.start(), found.end()])
+    row, last = 0, 0  # the points (row, column), counted along the file once
+    for start, end in spans:
+        points = []
+        for offset in (start, end):
+            row += before.count(b"\n", last, offset)
+            line_start = before.rfind(b"\n", 0, offset) + 1 if row else 0
+            points.append(Point(row, offset - line_start))
+            last = offset
+        copy.edit(start, end, end, points[0], points[1], points[1])
     return copy
+
+
+_DIFFERENT = re.compile(rb"[^\x00]+")
 
 
 def errors_and_missing(root: Node) -> dict[str, list[Node]]:
@@ -168,6 +170,33 @@ def errors_and_missing(root: Node) -> dict[str, list[Node]]:
             if child.has_error:
                 stack.append(child)
     return {"error": errors, "missing": missing}
+
+
+Parents = dict[int, tuple[Node, Node]]  # a MISSING token's id -> (the token, its parent)
+
+
+def missing_parents(root: Node) -> Parents:
+    """The parent of each token the parser invented, found in one walk of the subtrees
+    that hold an error: ``node.parent`` walks down from the root again for each node, which
+    for thousands of tokens thousands of levels deep took minutes."""
+    parents: Parents = {}
+    stack = [root] if root.has_error else []
+    while stack:
+        parent = stack.pop()
+        for child in parent.children:
+            if child.is_missing:
+                parents[child.id] = (child, parent)
+            if child.has_error:
+                stack.append(child)
+    return parents
+
+
+def parent_of(node: Node, parents: Parents) -> Node | None:
+    """``node``'s parent, from ``parents`` if it holds this node of this tree."""
+    known = parents.get(node.id)
+    if known is not None and known[0] == node:  # equal nodes: the same tree, the same node
+        return known[1]
+    return node.parent
 
 
 #: Nodes that may hold a function definition between declarations.

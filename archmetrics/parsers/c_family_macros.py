@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import bisect
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 from archmetrics.parsers.c_family_text import blank
@@ -39,6 +39,14 @@ _LEADING = (
 _WORD = rb"[^;{}()=\s/]++"  # a word of a declaration's type: no comment, no statement
 _STATEMENT = rb"(?:return|else|case|goto|throw|co_return|co_yield|new|delete|sizeof|typename)\b"
 _QUALIFIERS = rb"(?:\s*+(?:const|noexcept|override|final|volatile|&&|&|throw\s*\(\s*\)))*+"
+# a type, then a declarator's name and its `(`: `Vec128<T, N> operator==(`, `Foo* Make(`
+_TEMPLATE_ARGS = rb"<(?:[^<>;{}]++|<(?:[^<>;{}]++|<[^<>;{}]*+>)*+>)*+>"
+_NO_STATEMENT = rb"(?!" + _STATEMENT + rb")"
+_TYPE = rb"(?:const\s++)?" + _NO_STATEMENT + rb"(?!operator\b)[A-Za-z_][\w:]*+"
+_TYPE += rb"(?:\s*+" + _TEMPLATE_ARGS + rb"(?:::[A-Za-z_]\w*+)*+)?"
+_DECLARATOR = _NO_STATEMENT + rb"(?:~?[A-Za-z_][\w:]*+(?:\s*+" + _TEMPLATE_ARGS + rb")?"
+_DECLARATOR += rb"|operator\s*+(?:\(\s*+\)|[^\s(]++))\s*+\("
+_TYPE_THEN_DECLARATOR = _TYPE + rb"(?:\s*+[*&]++\s*+|\s++)" + _DECLARATOR
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +66,20 @@ def _attribute(names: Sequence[str]) -> bytes:
 
 
 @dataclass(frozen=True, slots=True)
+class Scan:
+    """A rule's ``pattern`` and the literal it begins with (``start``: a keyword, a bracket,
+    a newline). Over a whole file the pattern is searched; in a few small spans, the
+    literal is found first and the pattern tried only there (c.f. ``_matches``)."""
+
+    pattern: re.Pattern[bytes]
+    start: re.Pattern[bytes]
+
+
+def _scan(start: bytes, pattern: bytes) -> Scan:
+    return Scan(re.compile(pattern), re.compile(start))
+
+
+@dataclass(frozen=True, slots=True)
 class Rule:
     """Where a macro stands that tree-sitter cannot read: ``patterns`` (any of them) match
     it, their last matching group is what is blanked. ``between``: only between
@@ -71,7 +93,7 @@ class Rule:
     allows: Python's ``re`` then jumps from one occurrence of it to the next instead of
     trying the pattern at every byte, five to ten times faster over a file."""
 
-    patterns: tuple[re.Pattern[bytes], ...]
+    patterns: tuple[Scan, ...]
     between: bool = False
     before: bool = False
     word: bool = False
@@ -79,15 +101,15 @@ class Rule:
     types: bool = False
 
 
-def _keywords(words: tuple[bytes, ...], rest: bytes) -> tuple[re.Pattern[bytes], ...]:
+def _keywords(words: tuple[bytes, ...], rest: bytes) -> tuple[Scan, ...]:
     """One pattern per keyword (or punctuation), each starting with its literal; a keyword's
     start is checked in code (``Rule.word``): a look-behind would cost the literal start."""
-    return tuple(re.compile(word + rest) for word in words)
+    return tuple(_scan(word, word + rest) for word in words)
 
 
-def _at_line_start(rest: bytes) -> tuple[re.Pattern[bytes], ...]:
+def _at_line_start(rest: bytes) -> tuple[Scan, Scan]:
     """``rest`` at the start of a line: after a newline, or at the start of the file."""
-    return re.compile(rb"\n" + rest), re.compile(rb"\A" + rest)
+    return _scan(rb"\n", rb"\n" + rest), _scan(rb"\A", rb"\A" + rest)
 
 
 def _rules(names: MacroNames) -> tuple[Rule, ...]:
@@ -102,27 +124,62 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
                        + rb"(?:\s*<[^;{}()]*>)?\s*(?:final\b|:(?!:)|\{))|" + _NAME
                        + rb"\s++(?!final\b)(" + macro + _ARGS
                        + rb"?+)(?=\s*(?::(?!:)|\{)))"), before=True, word=True),
+        # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT; before the
+        # first parse where a declaration's keyword follows (tree-sitter would read the
+        # macro as the type of what follows: ABSL_NAMESPACE_BEGIN / class Notification {)
+        Rule(_at_line_start(rb"[ \t]*+(" + macro + rb")" + line_end + rb"(?=(?:\s*+//[^\n]*+)*+"
+                            rb"\s*+(?:class|struct|union|namespace|template|typedef|extern|using"
+                            rb"|enum)\b)"), alone=True, before=True),
         # a line holding nothing but a macro: RAPIDJSON_NAMESPACE_BEGIN, Q_OBJECT
         Rule(_at_line_start(rb"[ \t]*+(" + macro + rb")" + line_end), alone=True),
         # void Lock() EXCLUSIVE_LOCKS_REQUIRED(mu_);   int f() const OVERRIDE {
-        Rule((re.compile(rb"\)" + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS + rb"?+\s*+)++)"
+        Rule((_scan(rb"\)", rb"\)" + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS + rb"?+\s*+)++)"
                          + rb"(?=;|\{|=[^=]|:(?!:)|->|override\b|final\b|const\b|noexcept\b)"),),
              between=True),
         # a macro call alone on its line, not heading a body: RAPIDJSON_DIAG_OFF(effc++)
         Rule(_at_line_start(rb"[ \t]*+(" + macro + _ARGS + rb")" + line_end
                             + rb"(?!\s*[{:,.=])"), between=True, alone=True),
+        # in a body, a macro call alone on its line that the next line does not continue:
+        # OP(Py_LT, lt) in a switch (a statement macro, its `;` inside)
+        Rule(_at_line_start(rb"[ \t]*+(" + macro + _ARGS + rb")" + line_end
+                            + rb"(?!\s*+(?:[{:,.=+\-*/%&|^?<>)\]]|\Z))"), alone=True),
         # if EQ("a") {   while NOT_DONE(x) {
         Rule(_keywords((b"if", b"while", b"switch"), rb"\s+(?!constexpr\b)(" + _NAME
                        + rb")(?=\s*\()"), word=True),
         # static BROTLI_INLINE void f(   static CYTHON_INLINE int g(   (a built-in type follows)
         Rule(_keywords((b"static", b"extern", b"inline"), rb"\s++(" + macro + rb")(?=\s++"
                        + _BUILTIN + rb")"), between=True, word=True),
-        # void f(int * BROTLI_RESTRICT self, ...)   (between a `*` and a parameter's name)
-        Rule((re.compile(rb"\*\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"),)),
+        # void f(int * BROTLI_RESTRICT self, FUNC& HWY_RESTRICT g)   (after a `*` or `&`: no
+        # expression has a word after an operand there, so before the first parse)
+        Rule((_scan(rb"[*&]", rb"[*&]\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"),),
+             before=True),
         # ABSL_CONST_INIT static T x;   ABSL_MUST_USE_RESULT inline int f(   (macros heading
         # a declaration, before a keyword that begins one)
         Rule(_at_line_start(rb"[ \t]*+((?>" + macro + _ARGS + rb"?+[ \t]++)++)(?=" + _LEADING
                             + rb")"), between=True),
+        # HWY_API Vec128<T, N> operator==(   NPY_NO_EXPORT PyObject *f(   (macros heading a
+        # declaration, before a type and a declarator: two types side by side are no C; the
+        # run gives back its last word if that is the type: HWY_API T GetLane(
+        # static HWY_INLINE HWY_MAYBE_UNUSED bool f(   (after keywords, before keywords too;
+        # template NPY_NO_EXPORT int f<T>(   an explicit instantiation)
+        Rule(_at_line_start(rb"[ \t]*+(?:(?:static|inline|extern|constexpr|virtual|explicit"
+                            rb"|friend|template)[ \t]++)*+((?>" + macro + _ARGS
+                            + rb"?+[ \t]++)+)(?=(?:" + _LEADING + rb"\s++)*"
+                            + _TYPE_THEN_DECLARATOR + rb")"),
+             before=True),
+        # template <class D, HWY_IF_LANES_D(D, 1)>   (macros as template parameters, the list
+        # closed at the end of its line or before a declaration's keyword, or a `typename`
+        # parameter next)
+        Rule((_scan(b",", rb"(,\s*+" + macro + _ARGS + rb"(?>\s*+,\s*+" + macro + _ARGS
+                       + rb")*+)(?=\s*+(?:>[ \t]*+(?:\n|//|/\*|(?:class|struct|union|using|static"
+                       rb"|inline|constexpr|friend|typename)\b)|,\s*+(?:typename|class)\b))"),),
+             before=True),
+        # POCKETFFT_NOINLINE fftblue(size_t n) : n(n) {   (macros before a constructor, a
+        # definition without a return type; known by its initializer list or `= default`:
+        # before `{`, the macro could be the return type, `BOOL Check(int x) {`)
+        Rule(_at_line_start(rb"[ \t]*+(?:(?:inline|constexpr|explicit)[ \t]++)*+((?>" + macro
+                            + _ARGS + rb"?+[ \t]++)+)(?=~?" + _NAME + _ARGS + _QUALIFIERS
+                            + rb"\s*+(?::(?!:)|=\s*+(?:default|delete)\b))"), between=True),
         # bool done_ ABSL_GUARDED_BY(mu_) = false;    (a macro call after a declared name;
         # the type and the name on one line, read a word at a time)
         Rule(_at_line_start(rb"[ \t]*+(?>" + _WORD + rb"[ \t]++)*?" + _WORD
@@ -131,7 +188,7 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
                             + rb"(?>\s*+" + macro + _ARGS + rb")*+)(?=\s*+(?:;|=[^=]))"),
              between=True),
         # [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { ... }   (after a lambda's parameters)
-        Rule((re.compile(rb"\]\s*+" + _ARGS + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS
+        Rule((_scan(rb"\]", rb"\]\s*+" + _ARGS + _QUALIFIERS + rb"\s*+((?>" + macro + _ARGS
                          + rb"?+\s*+)++)(?=\{|->|mutable\b|noexcept\b)"),)),
         # ABSL_FLAG(int, name, 0, "help");  a type among a macro call's arguments: the type's
         # words (not blanked: rewritten as one identifier of the same length) in group 1;
@@ -206,14 +263,41 @@ _DIRECTIVE = _at_line_start(rb"[ \t]*+\#(?:[^\\\n]++|\\(?:\r?\n|.))*+")
 def directive_spans(data: bytes) -> _Ranges:
     """The byte ranges of ``data``'s preprocessor directives, continuation lines included."""
     after_newline, at_start = _DIRECTIVE
-    first = at_start.match(data)
+    first = at_start.pattern.match(data)
     spans = [first.span()] if first else []
-    return _Ranges(spans + [found.span() for found in after_newline.finditer(data)])
+    return _Ranges(spans + [found.span() for found in after_newline.pattern.finditer(data)])
 
 
 def literal_spans(data: bytes) -> _Ranges:
     """The byte ranges of ``data``'s string and character literals and comments."""
     return _Ranges([found.span() for found in _LITERALS.finditer(data)])
+
+
+def _matches(scan: Scan, data: bytes, spans: list[tuple[int, int]]) -> Iterator[re.Match[bytes]]:
+    """The matches of ``scan`` that start inside one of ``spans``, each as ``finditer``
+    would find it when searching from the span's start (a match may read up to
+    ``_LOOK_AHEAD`` bytes past the span's end). In a short span, the literal each begins
+    with is found first, so only the span's own bytes are searched, not the bytes after."""
+    size = len(data)
+    for start, end in spans:
+        limit = min(size, end + _LOOK_AHEAD)
+        if end - start > _LOOK_AHEAD:  # a long span: searched, the look-ahead costs little
+            for found in scan.pattern.finditer(data, start, limit):
+                if found.start() >= end:
+                    break
+                yield found
+            continue
+        resume = start
+        for candidate in scan.start.finditer(data, start, limit):
+            at = candidate.start()
+            if at >= end:
+                break
+            if at < resume:
+                continue
+            matched = scan.pattern.match(data, at, limit)
+            if matched is not None:
+                resume = matched.end()
+                yield matched
 
 
 def blank_macros(
@@ -230,22 +314,19 @@ def blank_macros(
     rules = _RULES.get(names)
     if rules is None:
         rules = _RULES.setdefault(names, _rules(names))
-    spans = [(0, len(data))] if near is None else list(near)
+    spans = None if near is None else list(near)
     hits = [
         (rule, found)
         for rule in rules
         if rule.before or not first
-        for pattern in rule.patterns
-        for start, end in spans
-        # a match that starts in the span may look ahead past its end, a little
-        for found in pattern.finditer(data, start, min(len(data), end + _LOOK_AHEAD))
-        if found.start() < end
-        and not (rule.word and found.start() and _WORD_BYTE[data[found.start() - 1]])
+        for scan in rule.patterns
+        for found in (scan.pattern.finditer(data) if spans is None else _matches(scan, data, spans))
+        if not (rule.word and found.start() and _WORD_BYTE[data[found.start() - 1]])
     ]
     if not hits:
         return data
     in_body = _Ranges(list(bodies))
-    wanted = _Ranges(spans) if near is not None else None
+    wanted = _Ranges(spans) if spans is not None else None
     literal = literal_spans(data)
     directive = directive_spans(data)
     out = bytearray(data)

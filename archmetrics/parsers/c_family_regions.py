@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import bisect
 import collections
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 from tree_sitter import Node
 
+from archmetrics.parsers.c_family_grammar import Parents, missing_parents, parent_of
 from archmetrics.parsers.c_family_text import whole_lines
 
 #: The captures that give a parse its shape: a region never cuts one of them in two.
@@ -35,19 +36,21 @@ class Layout:
         found: dict[str, list[Node]],
         data: bytes,
         set_aside: Sequence[tuple[int, int]] = (),
-        within: tuple[int, int] | None = None,
+        within: Sequence[tuple[int, int]] | None = None,
+        root: Node | None = None,
     ) -> None:
         """``data``: the bytes as written; ``set_aside``: byte ranges this parse did not
         read (#if branches its spelling blanked); ``within``: only the nodes that overlap
-        these bytes are wanted (no other can cross a region inside them)."""
+        these byte ranges (sorted, disjoint) are wanted (no other can cross a region
+        inside them); ``root``: the parse's tree (``damaged``)."""
         self.data = data
-        low, high = within if within is not None else (0, len(data) + 1)
+        wanted = _overlapping(within)
         nodes = sorted(
             {
                 (start, -end, node.type)
                 for name in STRUCTURE
                 for node in found.get(name, [])
-                if (end := node.end_byte) > low and (start := node.start_byte) < high
+                if wanted(start := node.start_byte, end := node.end_byte)
             }
         )
         self.starts = [start for start, _, _ in nodes]
@@ -71,7 +74,7 @@ class Layout:
             [whole_lines(data, s, e) for s, e in errors + [(m, m) for m in self.missing]]
         )
         self.set_aside = sorted(set_aside)
-        self.damaged = damaged(found, data, errors)
+        self.damaged = damaged(found, data, errors, root)
 
     def crossing(self, start: int, end: int) -> Iterator[tuple[int, int, str]]:
         """The nodes that overlap ``[start, end)`` without lying inside it."""
@@ -97,6 +100,20 @@ class Layout:
             index += 1
         invented = bisect.bisect_right(self.missing, end) - bisect.bisect_left(self.missing, start)
         return lost, invented
+
+
+def _overlapping(within: Sequence[tuple[int, int]] | None) -> Callable[[int, int], bool]:
+    """Whether ``[start, end)`` overlaps one of the sorted, disjoint ranges ``within``
+    (None: the whole file, whose ranges all end after its first byte)."""
+    if within is None:
+        return lambda start, end: end > 0
+    starts = [start for start, _ in within]
+
+    def overlaps(start: int, end: int) -> bool:
+        index = bisect.bisect_left(starts, end) - 1  # the last range that starts before end
+        return index >= 0 and within[index][1] > start
+
+    return overlaps
 
 
 def _first(ranges: list[tuple[int, int]], start: int) -> int:
@@ -127,14 +144,20 @@ def joined(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
 
 
 def damaged(
-    found: dict[str, list[Node]], data: bytes, errors: list[tuple[int, int]] | None = None
+    found: dict[str, list[Node]],
+    data: bytes,
+    errors: list[tuple[int, int]] | None = None,
+    root: Node | None = None,
 ) -> list[tuple[int, int]]:
     """The regions a parse damaged, sorted: its ``ERROR`` nodes and the nodes its invented
     tokens complete, those at most a line apart joined. ``errors``: the ``ERROR`` spans,
-    if known."""
+    if known; ``root``: the parse's tree, whose invented tokens' parents are then found in
+    one walk."""
     if errors is None:
         errors = [(node.start_byte, node.end_byte) for node in found.get("error", [])]
-    return _close(joined(errors + [_around(node) for node in found.get("missing", [])]), data)
+    missing = found.get("missing", [])
+    parents = missing_parents(root) if root is not None and missing else {}
+    return _close(joined(errors + [_around(node, parents) for node in missing]), data)
 
 
 def _close(ranges: list[tuple[int, int]], data: bytes) -> list[tuple[int, int]]:
@@ -150,9 +173,9 @@ def _close(ranges: list[tuple[int, int]], data: bytes) -> list[tuple[int, int]]:
     return closed
 
 
-def _around(missing: Node) -> tuple[int, int]:
+def _around(missing: Node, parents: Parents) -> tuple[int, int]:
     """The region a token the parser invented damages: the node it completes."""
-    parent = missing.parent  # one walk down from the root: there are few such tokens
+    parent = parent_of(missing, parents)
     node = parent if parent is not None else missing
     return node.start_byte, node.end_byte
 

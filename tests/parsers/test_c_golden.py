@@ -356,6 +356,17 @@ def test_and_before_an_assignment_counts_unlike_lizard() -> None:
     assert theirs.cyclomatic_complexity == 2  # the `&&` not counted
 
 
+def test_a_conditional_between_angle_brackets_counts_unlike_lizard() -> None:
+    """Disagreement class 6: lizard reads `i < 0 ? j >= k : ...` as template arguments
+    `< 0 ? j >` and skips the `?` inside them (numpy's f2c loops); it is a decision."""
+    import lizard
+
+    source = "int f(int n, int a, int b) {\n  return n < 0 ? a >= b : a <= b;\n}\n"
+    assert [d.kind for d in c(source).functions[0].decisions] == ["?"]
+    (theirs,) = lizard.analyze_file.analyze_source_code("f.c", source).function_list
+    assert theirs.cyclomatic_complexity == 1  # the `?` not counted
+
+
 def test_preprocessor_conditionals_outside_functions_are_no_decisions() -> None:
     facts = c("#if A && B\nint f(void) { return 0; }\n#endif\n")
     assert complexities(facts) == {"f": 1}

@@ -461,8 +461,19 @@ def test_an_inline_macro_and_a_restrict_macro_around_a_macro_named_function(
         '#if A\nint x = 1;\n#endif\nchar *s = "' + '"a' * 100_000 + "\n",  # quotes never closed
         "#if A \\\n" * 50_000 + "x\n#endif\nint g(void) { return 1; }\n",  # one long directive
         "#if A\nint x;\n#endif\n" + "int f() { @ }\n" * 20_000,  # 20,000 damaged regions
+        # a line of 50,000 macro-like words before a type whose template never closes
+        "X " * 50_000 + "T<" + "a, " * 300_000 + "\nint f() { @ }\n",
+        # 2,000 invented `}` and `;`, 4,000 levels deep (5-7 minutes, a parent each)
+        "class A { void f() {" * 2_000 + "}" * 2_000 + ";",
     ],
-    ids=["open-comments", "open-strings", "continued-directive", "many-regions"],
+    ids=[
+        "open-comments",
+        "open-strings",
+        "continued-directive",
+        "many-regions",
+        "macro-run",
+        "invented-tokens",
+    ],
 )
 def test_pathological_preprocessor_input_is_read_in_near_linear_time(source: str) -> None:
     # each of these took minutes to hours when a step rescanned the rest of the file
@@ -711,3 +722,162 @@ def test_a_declaration_as_a_for_condition() -> None:
     )
     assert complexities(facts) == {"ParseInt": 3, "after": 2}
     assert not lost(facts)
+
+
+# --- numpy's vendored highway, pocketfft and C extension code --------------------------------
+
+
+def test_macros_heading_a_declaration_before_its_type_and_name() -> None:
+    # highway: every function is `HWY_API <type> <name>(`; read as a type and a qualified
+    # name missing its `::`, each one was damage, reread one by one (a fifth of the parse)
+    facts = facts_of(
+        """
+        template <size_t N>
+        HWY_API Mask128<uint32_t, N> operator==(Vec128<uint32_t, N> a,
+                                                Vec128<uint32_t, N> b) {
+          return a.raw == b.raw ? Mask128<uint32_t, N>{} : Mask128<uint32_t, N>{};
+        }
+        template <typename T, size_t N>
+        HWY_API T GetLane(const Vec128<T, N> v) { return v.raw ? 1 : 0; }
+        static HWY_INLINE HWY_MAYBE_UNUSED bool Check(int x) { return x > 0 && x < 9; }
+        NPY_NO_EXPORT PyObject *
+        PyArray_Thing(PyObject *self) { if (!self) return NULL; return self; }
+        template NPY_NO_EXPORT int
+        heapsort_<npy::int_tag>(void *start, npy_intp n);
+        template <typename T>
+        void Sort(T* HWY_RESTRICT keys, size_t n) { while (n) --n; }
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {
+        "operator==": 2,
+        "GetLane": 2,
+        "Check": 2,
+        "PyArray_Thing": 2,
+        "Sort": 2,
+    }
+    assert not lost(facts)
+
+
+def test_macros_among_template_parameters() -> None:
+    # highway's SFINAE macros, last in the list or before a `typename` parameter
+    facts = facts_of(
+        """
+        template <class D, HWY_IF_V_SIZE_LE_D(D, 16), HWY_IF_F16_D(D)>
+        HWY_API VFromD<D> Zero(D d) { return d ? VFromD<D>{} : VFromD<D>{}; }
+        template <class D, HWY_IF_V_SIZE_D(D, 16), typename T = TFromD<D>>
+        HWY_API Vec128<T> Load(D d, const T* HWY_RESTRICT aligned) {
+          if (aligned) return Vec128<T>{};
+          return Vec128<T>{};
+        }
+        template <class FUNC>
+        inline void Unroller(FUNC& HWY_RESTRICT f, const ptrdiff_t n) {
+          for (ptrdiff_t i = 0; i < n; ++i) f(i);
+        }
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {"Zero": 2, "Load": 2, "Unroller": 2}
+    assert not lost(facts)
+
+
+def test_a_return_type_in_capitals_is_kept_next_to_damage() -> None:
+    # zstd: `MEM_STATIC U16 MEM_read16(...) {` is a macro and a return type, not a macro
+    # run before a constructor (45 functions were lost when the type was blanked too)
+    facts = facts_of(
+        """
+        MEM_STATIC U16 MEM_read16(const void* p) { return p ? *(const U16*) p : 0; }
+        BOOL Check(int x) { return x > 0; }
+        int broken(int a { @ }
+        """,
+        "c",
+    )
+    assert complexities(facts)["MEM_read16"] == 2
+    assert complexities(facts)["Check"] == 1
+
+
+def test_a_macro_before_a_constructor() -> None:
+    # pocketfft: the constructor without a return type closed the namespace early, and the
+    # 68 functions after it were lost
+    facts = facts_of(
+        """
+        namespace detail {
+        template<typename T0> class fftblue {
+          public:
+            POCKETFFT_NOINLINE fftblue(size_t length)
+              : n(length), plan(n)
+              { if (n == 0) throw 1; }
+            size_t length() const { return n; }
+        };
+        int after(int a) { return a ? 1 : 0; }
+        }
+        """,
+        "cpp",
+    )
+    assert complexities(facts) == {
+        "detail::fftblue::fftblue": 2,
+        "detail::fftblue::length": 1,
+        "detail::after": 2,
+    }
+    assert not lost(facts)
+
+
+@LANGUAGES
+def test_macro_calls_standing_for_statements_in_a_body(language: str) -> None:
+    # numpy's _rational_tests.c: `OP(...)` expands to a `case ...: ...; break;` of its own;
+    # unread, the function swallowed the rest of the file (22 functions)
+    facts = facts_of(
+        """
+        static PyObject*
+        richcompare(PyObject* a, PyObject* b, int op) {
+            int result = 0;
+            #define OP(py,op) case py: result = rational_##op(x,y); break;
+            switch (op) {
+                OP(Py_LT,lt)
+                OP(Py_LE,le)
+            };
+            #undef OP
+            return PyBool_FromLong(result);
+        }
+        static PyObject* repr(PyObject* self) { if (!self) return NULL; return self; }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"richcompare": 1, "repr": 2}
+
+
+def test_a_namespace_macro_alone_before_a_class() -> None:
+    # abseil: ABSL_NAMESPACE_BEGIN, then comments, then the class: read as the class's
+    # type, the class became one function and its constructors were lost
+    facts = facts_of(
+        """
+        namespace absl {
+        ABSL_NAMESPACE_BEGIN
+
+        // Notification
+        class Notification {
+         public:
+          Notification() : notified_yet_(false) {}
+          explicit Notification(bool prenotify) : notified_yet_(prenotify) {}
+          bool HasBeenNotified() const { return notified_yet_ && ready_; }
+        };
+        ABSL_NAMESPACE_END
+        }  // namespace absl
+        """,
+        "cpp",
+    )
+    assert [(f.qualified_name, f.complexity) for f in facts.functions] == [
+        ("absl::Notification::Notification", 1),
+        ("absl::Notification::Notification", 1),
+        ("absl::Notification::HasBeenNotified", 2),
+    ]
+    assert [c.name for c in facts.classes] == ["Notification"]
+    assert not lost(facts)
+
+
+def test_macros_heading_an_explicit_instantiation_are_blanked_before_the_first_parse() -> None:
+    # numpy's npysort: 40 such lines, each a damaged region reread before
+    text = b"\ntemplate NPY_NO_EXPORT int\nheapsort_<npy::int_tag>(void *start, npy_intp n);\n"
+    assert blank_macros(text, first=True) == text.replace(b"NPY_NO_EXPORT", b" " * 13)
+    kept = b"\nreturn FOO bar(x);\nelse BAR baz(y);\n"  # statements, not declarations
+    assert blank_macros(kept, first=True) == kept

@@ -142,6 +142,9 @@ _NOT_IN_LIZARD = {"#ifndef", "#elifdef", "#elifndef"}
 _AND_OR = re.compile(r"\b(and|or)\b")
 _RVALUE = re.compile(r"&&\s*(\w+\s*[:),]|[>),.{;]|noexcept\b|const\b)")
 _TRY_BLOCK = re.compile(r"\)\s*(const\s*)?try\s*\{")
+# class 6: `i < 0 ? j >= k : ...` read by lizard as template arguments `< 0 ? j >`, whose
+# `?` (or `&&`, `||`) it then skips
+_IN_ANGLES = re.compile(r"<[^;<>]*?(?:\?|&&|\|\|)[^;]*?>")
 # lizard's rvalue-reference heuristic: a `&&` followed by a lone `=` before any of `;{})`
 # is taken for `T&& x = ...` and not counted (`while (t && (x = next(t)) != 0)`)
 _ASSIGNING_AND = re.compile(r"&&(?:[<>!=]=|[^=;{})])*?(?<![<>!=+\-*/%&|^])=(?!=)")
@@ -162,6 +165,13 @@ def _disagreement_class(source_lines: list[str], ours: Function, expected: int) 
     assigning = len(_ASSIGNING_AND.findall(body))
     if delta > 0 and assigning and delta == ifndef + and_or + assigning:
         return "5: && before an assignment (lizard takes it for T&& x = ...)"
+    in_angles = sum(
+        1
+        for d in ours.decisions
+        if d.kind in ("?", "&&", "||") and _IN_ANGLES.search(source_lines[d.line - 1])
+    )
+    if delta > 0 and in_angles and delta <= ifndef + and_or + assigning + in_angles:
+        return "6: a < b ? c > d read as template arguments (lizard skips what is inside)"
     if delta < 0 and _RVALUE.search(body):
         return "3: rvalue reference && (lizard counts it)"
     if _TRY_BLOCK.search(body):
