@@ -265,7 +265,8 @@ def parse_in_workers(
                 if _watch(worker, run) is False:
                     worker.stop()
                     crew[index] = _Worker(context, overrides, limits)
-            _wait(crew, limits)
+            if not (run.pending and any(not worker.batch for worker in crew)):
+                _wait(crew, limits)  # a worker that just answered gets its next batch first
 
 
 @contextmanager

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from archmetrics.app.workers import Parsed, parse_in_workers
 from tests.gitrepo import GitRepo
 from tests.untrusted import run_cli
 
@@ -244,3 +245,50 @@ def test_configured_macros_reach_the_c_parser_and_key_the_cache(
     functions = files["proxy.cpp"]["functions"]
     assert [(f["qualified_name"], f["vg"]) for f in functions] == [("Proxy::get", 2)]  # type: ignore[attr-defined]
     assert files["proxy.cpp"]["warnings"] == []
+
+
+NAPPING = """
+import time
+
+from archmetrics.parsers import LanguageSpec
+from archmetrics.parsers.python import parse as parse_python
+
+
+def parse(path, source):
+    if "NAP" in source:
+        time.sleep(3)
+    return parse_python(path, source)
+
+
+SPEC = LanguageSpec("napping", parse)
+"""
+
+
+def test_a_worker_that_answers_gets_its_next_batch_while_another_is_busy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One worker reads a file that takes 3 s; the other must go through every other batch
+    meanwhile, not wait for its colleague (or the parent's 1 s poll) between batches."""
+    site = tmp_path / "site"
+    (site / "napping-1.0.dist-info").mkdir(parents=True)
+    (site / "napping_lang.py").write_text(NAPPING)
+    (site / "napping-1.0.dist-info" / "METADATA").write_text("Name: napping\nVersion: 1.0\n")
+    (site / "napping-1.0.dist-info" / "entry_points.txt").write_text(
+        "[archmetrics.languages]\nnapping = napping_lang:SPEC\n"
+    )
+    monkeypatch.syspath_prepend(str(site))  # forked workers inherit it
+    batches = [["slow"]] + [[f"fast{i}"] for i in range(12)]
+    answered: list[str] = []
+
+    def tasks(batch: list[str]) -> list[tuple[str, bytes, str]]:
+        return [
+            (name, b"x = 1  # NAP\n" if name == "slow" else b"y = 2\n", "napping") for name in batch
+        ]
+
+    def deliver(name: str, answer: Parsed) -> None:
+        assert answer.encoded is not None, answer.failure
+        answered.append(name)
+
+    parse_in_workers(batches, tasks, deliver, workers=2)
+    assert answered[-1] == "slow"
+    assert sorted(answered[:-1]) == sorted(f"fast{i}" for i in range(12))
