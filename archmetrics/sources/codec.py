@@ -39,7 +39,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 4
+FORMAT = 5
 
 _new = tuple.__new__
 
@@ -57,20 +57,9 @@ def _json(document: Any) -> bytes:
 
 
 def encode(facts: FileFacts) -> bytes:
-    statements = _json([[s.kind, *_span(s.span), s.text, s.function] for s in facts.statements])
-    calls = _json(
-        [
-            [
-                c.callee,
-                c.name,
-                c.receiver,
-                *_span(c.span),
-                c.function,
-                [[a.text, a.value, a.is_literal, a.keyword] for a in c.arguments],
-            ]
-            for c in facts.call_sites
-        ]
-    )
+    # records are named tuples: json writes each as a list in its fields' order, in C
+    statements = _json(tuple(facts.statements))  # [kind, [start, end], text, function]
+    calls = _json(tuple(facts.call_sites))  # [callee, name, receiver, span, arguments, fn]
     document = [
         FORMAT,
         facts.language,
@@ -143,7 +132,7 @@ def _statements(rows: list[list[Any]]) -> list[Statement]:
     spans = _Spans()
     return [
         _new(Statement, (intern(k), spans[a, b], intern(t), fn and intern(fn)))
-        for k, a, b, t, fn in rows
+        for k, (a, b), t, fn in rows
     ]
 
 
@@ -172,7 +161,7 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
                 fn and intern(fn),
             ),
         )
-        for callee, call, recv, a, b, fn, args in rows
+        for callee, call, recv, (a, b), args, fn in rows
     ]
 
 

@@ -109,7 +109,7 @@ def _joined(document: list[Any], calls: bytes, statements: bytes) -> bytes:
 def _tampered(edit: str) -> bytes:
     document, calls, statements = _parts()
     if edit == "statement":  # a statement starting on line 0, the checksum left as it was
-        statements = statements.replace(b'"assign",1,2', b'"assign",0,2')
+        statements = statements.replace(b'"assign",[1,2]', b'"assign",[0,2]')
     elif edit == "call":  # an argument with two fields of four
         calls = calls.replace(b'["x",null,false,"timeout"]', b'["x",null]')
     else:
@@ -138,7 +138,7 @@ def test_statements_and_calls_are_decoded_when_first_read() -> None:
 def test_records_damaged_behind_a_good_checksum_fail_when_read(part: str) -> None:
     document, calls, statements = _parts()
     if part == "statements":
-        statements = statements.replace(b'"assign",1,2', b'"assign",0,2')
+        statements = statements.replace(b'"assign",[1,2]', b'"assign",[0,2]')
         document[2][1] = zlib.crc32(statements)
     else:
         calls = calls.replace(b'"bus.request","request"', b'"bus.request",7')
