@@ -151,14 +151,23 @@ class Reading:
             found = _captures_within(built, root, within)
         return cls(data, tree, found, _damage(found))
 
-    def completed(self, built: Grammar, limits: ParseLimits) -> Reading | str:
-        """This reading with every capture of the full query, or why there is none."""
+    def completed(
+        self,
+        built: Grammar,
+        limits: ParseLimits,
+        within: Sequence[tuple[int, int]] | None = None,
+    ) -> Reading | str:
+        """This reading with every capture of the full query (``within``: only those that
+        overlap these byte ranges, as ``of`` takes them), or why there is none."""
         if self.complete:
             return self
         problem = _too_deep(self.root, limits)
         if problem is not None:
             return problem
-        found = QueryCursor(built.query).captures(self.root)
+        if within is None:
+            found = QueryCursor(built.query).captures(self.root)
+        else:
+            found = _captures_within(built, self.root, within)
         return Reading(self.data, self.tree, found, _damage(found))
 
     def standalone(self) -> list[Node]:
@@ -322,10 +331,25 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     reduced: list[Group] | None = None  # the groups one branch at a time: near ALL's damage
     while index < len(spellings):
         spelling = conditionals.spelling(spellings[index], groups, reduced)
-        other = Reading.of(built, spelling.data, limits, reading, window)
+        # once every damaged region has a reader, a one-branch spelling is judged first by
+        # the code it sets aside, then by its parse's damage alone, and captured only if it
+        # may still read a region better
+        probe = spellings[index] != ALL and _covered(base, choices)
         index += 1
+        if probe and not _may_read_better(
+            Layout({}, reading.data, spelling.set_aside), base, layouts, choices
+        ):
+            continue
+        other = Reading.of(built, spelling.data, limits, reading, window, damage_only=probe)
         if isinstance(other, str):
             continue
+        if not other.complete:
+            damage = Layout(other.found, reading.data, spelling.set_aside, root=other.root)
+            if not _may_read_better(damage, base, layouts, choices):
+                continue
+            other = other.completed(built, limits, window)
+            if isinstance(other, str):
+                continue
         readings.append(other)
         layouts.append(Layout(other.found, reading.data, spelling.set_aside, root=other.root))
         if spellings[index - 1] == ALL:
@@ -345,6 +369,34 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     if not choices:
         return None
     return _merge(reading, readings, choices, found_in)
+
+
+def _covered(base: Layout, choices: list[Choice]) -> bool:
+    """Whether every damaged region of ``base`` lies inside a chosen region."""
+    starts = [choice.start for choice in choices]
+    for start, end in base.damaged:
+        index = bisect.bisect_right(starts, start) - 1
+        if index < 0 or end > choices[index].end:
+            return False
+    return True
+
+
+def _may_read_better(
+    damage: Layout, base: Layout, layouts: list[Layout], choices: list[Choice]
+) -> bool:
+    """Whether a spelling may be chosen for one of ``base``'s damaged regions, each of
+    which lies inside one of ``choices``. ``damage`` gives the spelling's damage, or a
+    lower bound of it: its errors, invented tokens and set-aside branches, or the
+    set-aside branches alone (no structure either way). A spelling's region for a damaged
+    region holds that region (``grow`` only widens), and damage only grows with the
+    region, so a spelling with at least the chosen damage inside the damaged region
+    itself cannot read it with less (docs/metrics.md, "Macros and #if")."""
+    starts = [choice.start for choice in choices]
+    for start, end in base.damaged:
+        chosen = choices[bisect.bisect_right(starts, start) - 1]
+        if damage.damage(start, end) < layouts[chosen.reader].damage(chosen.start, chosen.end):
+            return True
+    return False
 
 
 def _spellings(groups: list[Group]) -> list[int]:
@@ -403,12 +455,9 @@ def _around(data: bytes, damaged: list[tuple[int, int]], lines: int) -> tuple[in
 
 def _all_read(base: Layout, layouts: list[Layout], choices: list[Choice]) -> bool:
     """Whether every damaged region of ``base`` is read without damage by its choice."""
-    starts = [choice.start for choice in choices]
-    for start, end in base.damaged:
-        index = bisect.bisect_right(starts, start) - 1
-        if index < 0 or end > choices[index].end:
-            return False
-    return all(layouts[c.reader].damage(c.start, c.end) == (0, 0) for c in choices)
+    return _covered(base, choices) and all(
+        layouts[c.reader].damage(c.start, c.end) == (0, 0) for c in choices
+    )
 
 
 def _merge(

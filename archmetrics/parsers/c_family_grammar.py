@@ -85,8 +85,13 @@ def grammar(language: str) -> Grammar:
     module = importlib.import_module("tree_sitter_c" if is_c else "tree_sitter_cpp")
     ts_language = TSLanguage(module.language())
     rules = c_tables.C_STATEMENTS if is_c else c_tables.CPP_STATEMENTS
-    patterns = [p for p in _patterns(ts_language, rules) if _compiles(ts_language, p)]
-    built = Grammar(Parser(ts_language), Query(ts_language, "\n".join(patterns)), rules)
+    patterns = _patterns(ts_language, rules)
+    try:  # C++ has every node type the patterns name: one compile, not one per pattern
+        query = Query(ts_language, "\n".join(patterns))
+    except QueryError:
+        kept = [pattern for pattern in patterns if _compiles(ts_language, pattern)]
+        query = Query(ts_language, "\n".join(kept))
+    built = Grammar(Parser(ts_language), query, rules)
     _GRAMMARS[language] = built
     return built
 
