@@ -331,35 +331,37 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
     reduced: list[Group] | None = None  # the groups one branch at a time: near ALL's damage
     while index < len(spellings):
         spelling = conditionals.spelling(spellings[index], groups, reduced)
-        # once every damaged region has a reader, a one-branch spelling is judged first by
-        # the code it sets aside, then by its parse's damage alone, and captured only if it
-        # may still read a region better
-        probe = spellings[index] != ALL and _covered(base, choices)
+        # a spelling is judged first by the code it sets aside (no parse), then by its
+        # parse's errors alone (no query), and captured only if it may still read a damaged
+        # region better than the first reading or the spelling chosen there so far
+        branch = spellings[index]
         index += 1
-        if probe and not _may_read_better(
+        if branch != ALL and not _may_read_better(
             Layout({}, reading.data, spelling.set_aside), base, layouts, choices
         ):
             continue
-        other = Reading.of(built, spelling.data, limits, reading, window, damage_only=probe)
+        other = Reading.of(built, spelling.data, limits, reading, window, damage_only=True)
         if isinstance(other, str):
             continue
         if not other.complete:
-            damage = Layout(other.found, reading.data, spelling.set_aside, root=other.root)
-            if not _may_read_better(damage, base, layouts, choices):
+            lost = Layout(other.found, reading.data, spelling.set_aside, root=other.root)
+            if branch == ALL:
+                reduced = _still_damaged(reading.data, groups, lost)
+                if reduced is not None:  # one branch at a time only where it can read more
+                    spellings = _spellings(reduced)
+            if not _may_read_better(lost, base, layouts, choices):
                 continue
             other = other.completed(built, limits, window)
             if isinstance(other, str):
                 continue
         readings.append(other)
         layouts.append(Layout(other.found, reading.data, spelling.set_aside, root=other.root))
-        if spellings[index - 1] == ALL:
+        if branch == ALL and other.complete:  # read without damage: every group may help
             reduced = _still_damaged(reading.data, groups, layouts[-1])
-            if reduced is not None:  # one branch at a time only where it can read more
-                spellings = _spellings(reduced)
         found_in.append(spelling.decisions)
         choices = choose(base, layouts)
         if window is not None and not all(_inside(window, c.start, c.end) for c in choices):
-            window, index, readings, layouts, found_in = None, 0, [], [], []
+            window, index, readings, layouts, found_in, choices = None, 0, [], [], [], []
             groups, reduced = conditionals.near(None), None
             spellings = _spellings(groups)
             base = Layout(reading.found, reading.data, root=reading.root)
@@ -384,17 +386,22 @@ def _covered(base: Layout, choices: list[Choice]) -> bool:
 def _may_read_better(
     damage: Layout, base: Layout, layouts: list[Layout], choices: list[Choice]
 ) -> bool:
-    """Whether a spelling may be chosen for one of ``base``'s damaged regions, each of
-    which lies inside one of ``choices``. ``damage`` gives the spelling's damage, or a
-    lower bound of it: its errors, invented tokens and set-aside branches, or the
-    set-aside branches alone (no structure either way). A spelling's region for a damaged
-    region holds that region (``grow`` only widens), and damage only grows with the
-    region, so a spelling with at least the chosen damage inside the damaged region
-    itself cannot read it with less (docs/metrics.md, "Macros and #if")."""
+    """Whether a spelling whose damage ``damage`` gives (its errors, invented tokens and
+    set-aside branches, or a lower bound of them: the set-aside branches alone; no
+    structure) loses less inside one of ``base``'s damaged regions than the best reading
+    of it so far: the spelling chosen for a region that holds it, else the first reading.
+    A spelling that does not is not read further (docs/metrics.md, "Macros and #if"). Where
+    a spelling was chosen, this changes nothing: the region a spelling gets holds the
+    damaged region (``grow`` only widens) and damage only grows with the region."""
     starts = [choice.start for choice in choices]
     for start, end in base.damaged:
-        chosen = choices[bisect.bisect_right(starts, start) - 1]
-        if damage.damage(start, end) < layouts[chosen.reader].damage(chosen.start, chosen.end):
+        index = bisect.bisect_right(starts, start) - 1
+        if index >= 0 and end <= choices[index].end:
+            chosen = choices[index]
+            best = layouts[chosen.reader].damage(chosen.start, chosen.end)
+        else:
+            best = base.damage(start, end)
+        if damage.damage(start, end) < best:
             return True
     return False
 

@@ -427,6 +427,49 @@ def test_a_rereading_gives_the_facts_a_fresh_parse_gives(monkeypatch: pytest.Mon
     assert all(len(facts.functions) >= 1 for facts in incremental)
 
 
+_BRANCHY = [
+    (  # f's region grows past the damage; h's #if splits a condition in every spelling
+        "c",
+        "int f(int s) {\n#ifdef W\n  if (s == 1)\n#else\n  if (s < 0)\n#endif\n"
+        "  { return -1; }\n  return 0;\n}\nint h(int s) {\n#ifdef Q\n  if (s &&\n#else\n"
+        "  if (t &&\n#endif\n  u) return 2;\n  return 0;\n}\nint g(void) { return 1; }\n",
+    ),
+    (
+        "c",
+        "int f(int s) {\n#ifdef W\n  if (s == 1)\n#else\n  if (s < 0)\n#endif\n"
+        "  { return -1; }\n  return 0;\n}\nint g(void) { return 1; }\n",
+    ),
+    (
+        "c",
+        "int f(int a) {\n  if (\n#ifdef X\n a > 1\n#else\n a > 2\n#endif\n ) return 1;\n"
+        "  return 0;\n}\n" * 3,
+    ),
+    (
+        "cpp",
+        "namespace n {\nstruct S {\n#if A\n  int get() const { return m_; }\n  int m_;\n#else\n"
+        "  int get() const { return m_.load(); }\n  atomic<int> m_;\n#endif\n"
+        + "".join(f"  int g{i}() {{ return {i}; }}\n" for i in range(30))
+        + "  size_t Index() const {\n#if B\n    if (a &&\n#else\n    if (b &&\n#endif\n"
+        "        c) return 1;\n    return 0;\n  }\n};\n}\n",
+    ),
+]
+
+
+@pytest.mark.parametrize("lines", [0, 2])
+def test_the_lines_captured_around_the_damage_do_not_change_the_facts(
+    monkeypatch: pytest.MonkeyPatch, lines: int
+) -> None:
+    """Spellings are captured only near the damage, and the whole file is read again when a
+    chosen region grows past that; with no or few lines of margin every file takes that path,
+    and must come to the same facts."""
+    from archmetrics.parsers import c_family
+
+    usual = [facts_of(source, language) for language, source in _BRANCHY]
+    monkeypatch.setattr(c_family, "_CONTEXT_LINES", lines)
+    assert [facts_of(source, language) for language, source in _BRANCHY] == usual
+    assert all(facts.functions and not facts.warnings for facts in usual)
+
+
 @LANGUAGES
 def test_an_inline_macro_and_a_restrict_macro_around_a_macro_named_function(
     language: str,
