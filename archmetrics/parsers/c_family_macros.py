@@ -149,10 +149,11 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
         # static BROTLI_INLINE void f(   static CYTHON_INLINE int g(   (a built-in type follows)
         Rule(_keywords((b"static", b"extern", b"inline"), rb"\s++(" + macro + rb")(?=\s++"
                        + _BUILTIN + rb")"), between=True, word=True),
-        # void f(int * BROTLI_RESTRICT self, FUNC& HWY_RESTRICT g)   (after a `*` or `&`: no
-        # expression has a word after an operand there, so before the first parse)
-        Rule((_scan(rb"[*&]", rb"[*&]\s*+(" + macro + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[])"),),
-             before=True),
+        # void f(int * BROTLI_RESTRICT self, FUNC& HWY_RESTRICT g)   const T* const
+        # HWY_RESTRICT p)   T* HWY_RESTRICT pos = x;   (after a `*` or `&`: no expression
+        # has a word after an operand there, so before the first parse)
+        Rule((_scan(rb"[*&]", rb"[*&]\s*+(?:(?:const|volatile)\s++)*+(" + macro
+                    + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[=;])"),), before=True),
         # ABSL_CONST_INIT static T x;   ABSL_MUST_USE_RESULT inline int f(   (macros heading
         # a declaration, before a keyword that begins one)
         Rule(_at_line_start(rb"[ \t]*+((?>" + macro + _ARGS + rb"?+[ \t]++)++)(?=" + _LEADING

@@ -824,6 +824,30 @@ def test_macros_among_template_parameters() -> None:
     assert not lost(facts)
 
 
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_a_restrict_macro_after_const_or_in_a_body(language: str) -> None:
+    # highway: `const float* const HWY_RESTRICT row_;` is one member, `T* HWY_RESTRICT pos =
+    # out;` one declaration in a body
+    facts = facts_of(
+        """
+        struct Image {
+          const float* const HWY_RESTRICT first_row_;
+        };
+        int Copy(const float* const HWY_RESTRICT from, float* to, int n) {
+          float* HWY_RESTRICT pos = to;
+          for (int i = 0; i < n; ++i) pos[i] = from[i];
+          return n;
+        }
+        """,
+        language,
+    )
+    assert complexities(facts) == {"Copy": 2}
+    texts = [s.text for s in facts.statements]
+    assert "const float * const HWY_RESTRICT first_row_ ;" in texts
+    assert "float * HWY_RESTRICT pos = to ;" in texts
+    assert not lost(facts)
+
+
 def test_a_return_type_in_capitals_is_kept_next_to_damage() -> None:
     # zstd: `MEM_STATIC U16 MEM_read16(...) {` is a macro and a return type, not a macro
     # run before a constructor (45 functions were lost when the type was blanked too)
