@@ -46,7 +46,9 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
             return targets[0], DirectorySnapshot(targets[0]), ()
         root = Path(os.path.commonpath([str(t) for t in targets]))
         root = root if root.is_dir() else root.parent
-        return root, DirectorySnapshot(root), tuple(_relative(t, root) for t in targets)
+        on_disk = [t.relative_to(root).as_posix() if t != root else "" for t in targets]
+        snapshot = DirectorySnapshot(root, within=on_disk)
+        return root, snapshot, tuple(_relative(t, root) for t in targets)
     repo = git.open_repository(anchor)
     root = git.toplevel(repo).resolve()
     snapshot = open_snapshot(root, request.rev)

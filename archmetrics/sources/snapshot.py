@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -76,10 +76,20 @@ class EmptySnapshot:
 class DirectorySnapshot:
     """Files under a directory on disk (outside git, or a working tree read directly)."""
 
-    def __init__(self, root: Path, paths: Iterable[str] | None = None, label: str = WORKTREE):
+    def __init__(
+        self,
+        root: Path,
+        paths: Iterable[str] | None = None,
+        label: str = WORKTREE,
+        within: Sequence[str] = (),
+    ):
+        """``paths``: exactly these files (relative to ``root``); ``within``: only the files
+        and folders (relative to ``root``, as on disk) to walk, so that measuring one file
+        does not list every file beside it; neither: the whole tree."""
         self.root = root
         self.label = label
         self._paths = tuple(sorted(paths)) if paths is not None else None
+        self._within = tuple(sorted(set(within))) if "" not in within else ()
         self._hashes: dict[str, str] = {}
         self._on_disk: dict[str, str] = {}  # quoted name -> the name on disk, where they differ
 
@@ -87,11 +97,17 @@ class DirectorySnapshot:
         if self._paths is not None:
             yield from self._paths
             return
-        for folder, dirs, names in os.walk(self.root):
-            dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.endswith(".egg-info"))
-            rel = Path(folder).relative_to(self.root)
-            for name in sorted(names):
-                yield (rel / name).as_posix()
+        if not self._within:
+            yield from _walk_folder(self.root, self.root)
+            return
+        found: set[str] = set()
+        for target in self._within:
+            full = self.root / target
+            if full.is_dir() and not full.is_symlink():
+                found.update(_walk_folder(self.root, full))
+            else:
+                found.add(target)
+        yield from sorted(found, key=_walk_order)
 
     def files(self) -> tuple[SourceFile, ...]:
         found = []
@@ -109,6 +125,23 @@ class DirectorySnapshot:
             return (self.root / self._on_disk.get(file.path, file.path)).read_bytes()
         except OSError as error:
             raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
+
+
+def _walk_folder(root: Path, folder: Path) -> Iterator[str]:
+    """The files under ``folder`` (relative to ``root``), in walk order, skipping the folders
+    no one measures (version control, virtual environments, caches)."""
+    for current, dirs, names in os.walk(folder):
+        dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.endswith(".egg-info"))
+        rel = Path(current).relative_to(root)
+        for name in sorted(names):
+            yield (rel / name).as_posix()
+
+
+def _walk_order(path: str) -> list[tuple[int, str]]:
+    """Where ``_walk_folder`` of the whole tree puts ``path``: a folder's files before its
+    subfolders, each in name order."""
+    *folders, name = path.split("/")
+    return [(1, folder) for folder in folders] + [(0, name)]
 
 
 def open_snapshot(root: Path, spec: str | None, paths: Sequence[str] = ()) -> Snapshot:
