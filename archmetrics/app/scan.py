@@ -47,8 +47,8 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
         root = Path(os.path.commonpath([str(t) for t in targets]))
         root = root if root.is_dir() else root.parent
         on_disk = [t.relative_to(root).as_posix() if t != root else "" for t in targets]
-        snapshot = DirectorySnapshot(root, within=on_disk)
-        return root, snapshot, tuple(_relative(t, root) for t in targets)
+        folder = DirectorySnapshot(root, within=on_disk)
+        return root, folder, tuple(_relative(t, root) for t in targets)
     repo = git.open_repository(anchor)
     root = git.toplevel(repo).resolve()
     snapshot = open_snapshot(root, request.rev)
