@@ -53,7 +53,11 @@ def _span(s: Span) -> list[int]:
 
 
 def _json(document: Any) -> bytes:
-    return json.dumps(document, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+    text = json.dumps(document, separators=(",", ":"), ensure_ascii=False)
+    try:
+        return text.encode("utf-8")
+    except UnicodeEncodeError:  # a lone surrogate (the value of "\ud800" in Python): escaped
+        return json.dumps(document, separators=(",", ":")).encode("ascii")
 
 
 def encode(facts: FileFacts) -> bytes:

@@ -84,6 +84,17 @@ def test_codec_round_trips_real_parser_output(language: str) -> None:
     assert codec.decode(codec.encode(facts), facts.path) == facts
 
 
+def test_codec_round_trips_a_string_value_that_is_a_lone_surrogate() -> None:
+    # Python's "\ud800" is a str no UTF-8 can hold: the record is written with JSON escapes
+    # (it made the file "not measured" and never cached)
+    facts = facts_of('loads(text="\\ud800")\nf("\\udc80", "é")\n', "python")
+    values = [a.value for c in facts.call_sites for a in c.arguments]
+    assert values == ["\ud800", "\udc80", "é"]
+    encoded = codec.encode(facts)
+    encoded.decode("utf-8")  # valid UTF-8, so any cache or pipe can hold it
+    assert codec.decode(encoded, facts.path) == facts
+
+
 def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types() -> None:
     source = "def f(self):\n    g(self, 0)\n    g(self, 0)\n    h(1)\n    h(1.0)\n    h(True)\n"
     facts = facts_of(source, "python")
