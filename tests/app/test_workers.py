@@ -43,17 +43,23 @@ SPEC = LanguageSpec("unruly", parse)
 FINE = "def f{i}(a):\n    if a:\n        return {i}\n    return 0\n"
 
 
+def _installed(site: Path, name: str, module: str) -> Path:
+    """``site`` holding distribution ``name`` whose ``{name}_lang`` module (``module``)
+    registers ``SPEC`` in the ``archmetrics.languages`` entry-point group."""
+    (site / f"{name}-1.0.dist-info").mkdir(parents=True)
+    (site / f"{name}_lang.py").write_text(module)
+    (site / f"{name}-1.0.dist-info" / "METADATA").write_text(f"Name: {name}\nVersion: 1.0\n")
+    (site / f"{name}-1.0.dist-info" / "entry_points.txt").write_text(
+        f"[archmetrics.languages]\n{name} = {name}_lang:SPEC\n"
+    )
+    return site
+
+
 @pytest.fixture
 def plugin(tmp_path: Path) -> dict[str, str]:
     """A third-party language (as installed through the ``archmetrics.languages`` entry-point
     group) whose parser crashes, hangs, hogs memory or raises on request."""
-    site = tmp_path / "site"
-    (site / "unruly-1.0.dist-info").mkdir(parents=True)
-    (site / "unruly_lang.py").write_text(PLUGIN)
-    (site / "unruly-1.0.dist-info" / "METADATA").write_text("Name: unruly\nVersion: 1.0\n")
-    (site / "unruly-1.0.dist-info" / "entry_points.txt").write_text(
-        "[archmetrics.languages]\nunruly = unruly_lang:SPEC\n"
-    )
+    site = _installed(tmp_path / "site", "unruly", PLUGIN)
     path = os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])
     return {"PYTHONPATH": path}
 
@@ -269,13 +275,7 @@ def test_a_worker_that_answers_gets_its_next_batch_while_another_is_busy(
 ) -> None:
     """One worker reads a file that takes 3 s; the other must go through every other batch
     meanwhile, not wait for its colleague (or the parent's 1 s poll) between batches."""
-    site = tmp_path / "site"
-    (site / "napping-1.0.dist-info").mkdir(parents=True)
-    (site / "napping_lang.py").write_text(NAPPING)
-    (site / "napping-1.0.dist-info" / "METADATA").write_text("Name: napping\nVersion: 1.0\n")
-    (site / "napping-1.0.dist-info" / "entry_points.txt").write_text(
-        "[archmetrics.languages]\nnapping = napping_lang:SPEC\n"
-    )
+    site = _installed(tmp_path / "site", "napping", NAPPING)
     monkeypatch.syspath_prepend(str(site))  # forked workers inherit it
     batches = [["slow"]] + [[f"fast{i}"] for i in range(12)]
     answered: list[str] = []
