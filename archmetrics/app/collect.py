@@ -72,9 +72,12 @@ def parse_all(
     progress: Progress | None = None,
     cache: FactsCache | None = None,
     limits: WorkerLimits = DEFAULT_LIMITS,
+    blobs: dict[str, str] | None = None,
 ) -> tuple[FileFacts, ...]:
     """Facts for every selected file, in the order given: from the cache when it has them,
-    else from worker processes (:mod:`archmetrics.app.workers`) within ``limits``."""
+    else from worker processes (:mod:`archmetrics.app.workers`) within ``limits``.
+    ``blobs``, if given, receives each selected path's git blob id (hashed here for a file
+    read from disk)."""
     progress = progress or NoProgress()
     results: list[FileFacts | None] = [None] * len(selected)
     todo: list[_Todo] = []
@@ -83,6 +86,8 @@ def parse_all(
         if not blob:  # a file on disk: hash it the way git would
             data = snapshot.read(item.file)
             blob = blob_hash(data)
+        if blobs is not None:
+            blobs[item.file.path] = blob
         hit = cache.get(blob, item.language, item.file.path) if cache else None
         if hit is None:
             todo.append(_Todo(index, item, blob, data))

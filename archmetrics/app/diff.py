@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import functools
+import hashlib
+import json
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import archmetrics
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import Progress
@@ -50,9 +54,17 @@ def location_rules(request: DiffRequest) -> LocationRules:
 
 
 def coupling_values(
-    files: Sequence[FileFacts], rules: LocationRules, options: CouplingOptions, packs: RuleSet
+    files: Sequence[FileFacts],
+    rules: LocationRules,
+    options: CouplingOptions,
+    packs: RuleSet,
+    cache: FactsCache | None = None,
+    blobs: Mapping[str, str] | None = None,
 ) -> dict[str, Coupling]:
-    """Element name -> (s_a, s_e, d_a, d_e) over the measured (not excluded) files of a tree."""
+    """Element name -> (s_a, s_e, d_a, d_e) over the measured (not excluded) files of a tree.
+
+    With a ``cache`` and the files' ``blobs``, the result is kept under a digest of all that
+    decides it (:func:`coupling_key`) and read back when the same tree is measured again."""
     measured = [
         f
         for f in files
@@ -60,8 +72,74 @@ def coupling_values(
         and not rules.is_excluded(f.path)
         and not (rules.exclude_generated and f.generated)
     ]
+    key = None
+    if cache is not None and blobs is not None:
+        key = coupling_key(measured, blobs, options, packs, cache.fingerprint)
+    if key is not None and cache is not None:
+        known = _read_coupling(cache.get_total(key))
+        if known is not None:
+            return known
     report = measure_coupling(measured, options, packs)
-    return {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
+    values = {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
+    if key is not None and cache is not None:
+        cache.put_total(key, json.dumps(values, separators=(",", ":")).encode())
+    return values
+
+
+def coupling_key(
+    measured: Sequence[FileFacts],
+    blobs: Mapping[str, str],
+    options: CouplingOptions,
+    packs: RuleSet,
+    parser: str,
+) -> str | None:
+    """A digest of what decides a tree's coupling: this archmetrics's code, the facts (each
+    file's path, blob and language, in order, under the ``parser`` fingerprint of the facts
+    cache, which holds the parser settings), the coupling options and the rule packs as
+    loaded. None if a file's blob is unknown."""
+    files = []
+    for facts in measured:
+        blob = blobs.get(facts.path)
+        if not blob:
+            return None
+        files.append((facts.path, blob, facts.language))
+    document = ["coupling/1", _code_fingerprint(), parser, repr(options), repr(packs), files]
+    return hashlib.sha256(json.dumps(document).encode()).hexdigest()
+
+
+@functools.cache
+def _code_fingerprint() -> str:
+    """A digest of archmetrics's own source: any change to how coupling is computed (or to
+    anything it uses) is a new key."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256(archmetrics.__version__.encode())
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _read_coupling(data: bytes | None) -> dict[str, Coupling] | None:
+    """Coupling values as ``coupling_values`` stored them, or None if ``data`` is anything
+    else (the cache file is not trusted: a bad entry is recomputed, never believed)."""
+    if data is None:
+        return None
+    try:
+        document = json.loads(data)
+    except ValueError:
+        return None
+    if not isinstance(document, dict):
+        return None
+    values: dict[str, Coupling] = {}
+    for name, numbers in document.items():
+        if not (
+            isinstance(numbers, list)
+            and len(numbers) == 4
+            and all(type(n) is int and n >= 0 for n in numbers)
+        ):
+            return None
+        values[name] = Coupling(*numbers)
+    return values
 
 
 def pair_files(
@@ -92,7 +170,11 @@ def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
 
 
 def _parse_side(
-    snapshot: Snapshot, request: DiffRequest, progress: Progress | None, cache: FactsCache | None
+    snapshot: Snapshot,
+    request: DiffRequest,
+    progress: Progress | None,
+    cache: FactsCache | None,
+    blobs: dict[str, str] | None = None,
 ) -> tuple[FileFacts, ...]:
     overrides = request.settings.languages
     selected = select(snapshot, LanguageTable.default(dict(overrides)))
@@ -100,7 +182,7 @@ def _parse_side(
         request.jobs or request.settings.jobs,
         worker_limits(request.settings.limits, request.settings.macros),
     )
-    return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
+    return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits, blobs)
 
 
 def measure_change(
@@ -112,16 +194,18 @@ def measure_change(
     base = open_snapshot(root, request.base)
     head = open_snapshot(root, request.head)
     rules = location_rules(request)
-    pre = _parse_side(base, request, progress, cache)
-    post = _parse_side(head, request, progress, cache)
+    pre_blobs: dict[str, str] = {}
+    post_blobs: dict[str, str] = {}
+    pre = _parse_side(base, request, progress, cache, pre_blobs)
+    post = _parse_side(head, request, progress, cache, post_blobs)
     options, packs = coupling_options(request.settings), rule_set(request.settings, root)
     paths = {f.path for f in (*pre, *post)}
     change = compute_change(
         pair_files(pre, post, git.renames(repo, request.base, request.head)),
         group_elements(paths, options.per_file),
         rules,
-        coupling_values(pre, rules, options, packs),
-        coupling_values(post, rules, options, packs),
+        coupling_values(pre, rules, options, packs, cache, pre_blobs),
+        coupling_values(post, rules, options, packs, cache, post_blobs),
         dynamic_pre_zero=request.dynamic_pre_zero,
     )
     return change, _warnings(pre, post)

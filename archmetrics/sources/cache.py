@@ -16,6 +16,7 @@ and parsed again. The cache is never trusted blindly, and never writes where it 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import sqlite3
@@ -164,6 +165,23 @@ class FactsCache:
             lambda db: db.executemany("insert or replace into facts values (?, ?, ?, ?)", rows)
         )
 
+    def get_total(self, key: str) -> bytes | None:
+        """What was stored under ``key`` (a digest of all that decides it), if anything.
+        The bytes are as untrusted as the file: the caller checks them."""
+        try:
+            row = self._run(
+                lambda db: db.execute("select data from totals where key=?", (key,)).fetchone()
+            )
+        except CacheError:  # no totals table (a read-only cache made before it): not kept
+            return None
+        return bytes(row[0]) if row is not None and isinstance(row[0], bytes) else None
+
+    def put_total(self, key: str, data: bytes) -> None:
+        with contextlib.suppress(CacheError):
+            self._run(
+                lambda db: db.execute("insert or replace into totals values (?, ?)", (key, data))
+            )
+
     def info(self) -> CacheInfo:
         total, current = self._run(
             lambda db: db.execute(
@@ -177,6 +195,7 @@ class FactsCache:
     def clear(self) -> int:
         self._decoded.clear()
         removed: int = self._run(lambda db: db.execute("delete from facts").rowcount)
+        self._run(lambda db: db.execute("delete from totals"))
         self._run(lambda db: db.commit())
         self._run(lambda db: db.execute("vacuum"))
         return removed

@@ -19,6 +19,7 @@ the person running archmetrics and may name any place.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sqlite3
 import stat
@@ -134,12 +135,19 @@ def open_database(path: Path, notices: list[str]) -> sqlite3.Connection:
         raise CacheError(f"facts cache {path}: cannot open: {error}") from error
     try:
         check(db)
+        with contextlib.suppress(sqlite3.OperationalError):  # read-only: no totals kept
+            db.execute(_TOTALS)  # a cache made before the totals table gains it, facts kept
     except (Damaged, sqlite3.DatabaseError) as error:
         db.close()
         if isinstance(error, sqlite3.DatabaseError) and not is_damage(error):
             raise CacheError(f"facts cache {path}: {error}") from error
         return rebuild(path, f"damaged ({error})", notices)
     return db
+
+
+# What a revision's facts add up to (a diff's coupling of one tree), by a digest of
+# everything that decides it (cache.py, ``FactsCache.get_total``).
+_TOTALS = "create table if not exists totals(key text primary key, data blob)"
 
 
 def check(db: sqlite3.Connection) -> None:
@@ -211,6 +219,7 @@ def _initialise(path: Path) -> None:
             "create table meta(key text primary key, value text);"
             "create table facts(blob text, language text, parser text, data blob,"
             " primary key(blob, language, parser));"
+            f"{_TOTALS};"
         )
         db.executemany(
             "insert into meta values (?, ?)", [("application", APPLICATION), ("schema", SCHEMA)]

@@ -1,0 +1,105 @@
+"""A diff keeps what each tree's facts add up to (its coupling) in the facts cache, keyed by
+all that decides it, and serves it back byte for byte; a bad entry is recomputed."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from archmetrics.cli import main
+from tests.gitrepo import GitRepo
+
+CLIENT = 'import zmq\nimport shared\n\nsock = zmq.Context().socket(zmq.REQ)\nsock.connect("tcp://localhost:5555")\n'
+SERVER = 'import zmq\n\nsock = zmq.Context().socket(zmq.REP)\nsock.bind("tcp://*:5555")\n'
+SHARED = "def helper(a):\n    return a if a else None\n"
+
+
+@pytest.fixture
+def history(repo: GitRepo) -> GitRepo:
+    repo.commit("one", tag="v1", files={"src/client.py": CLIENT, "src/shared.py": SHARED})
+    repo.commit(
+        "two",
+        tag="v2",
+        files={"src/server.py": SERVER, "src/shared.py": SHARED + "\nLIMIT = 3\n"},
+    )
+    return repo
+
+
+def _diff(repo: GitRepo, tmp_path: Path, *extra: str) -> bytes:
+    out = tmp_path / "out.json"
+    command = ["diff", "-C", str(repo.root), "--base", "v1", "--head", "v2", "-q"]
+    assert main([*command, "--format", "json", *extra, "-o", str(out)]) == 0
+    return out.read_bytes()
+
+
+def _totals(cache: Path) -> list[tuple[str, bytes]]:
+    with sqlite3.connect(cache) as db:
+        return db.execute("select key, data from totals order by key").fetchall()
+
+
+def test_each_trees_coupling_is_kept_and_served_byte_for_byte(
+    history: GitRepo, tmp_path: Path
+) -> None:
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(history, tmp_path, "--no-cache")
+    elements = {e["element"]: e for e in json.loads(plain)["elements"]}
+    assert elements["src/client.py"]["post"]["s_e"] == 2  # it imports zmq and shared
+    assert elements["src/server.py"]["post"]["d_a"] == 1  # the client's link to the new server
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain  # computed, kept
+    kept = _totals(cache)
+    assert len(kept) == 2  # one per tree
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain  # served
+    assert _totals(cache) == kept
+
+
+def test_a_setting_that_changes_coupling_is_another_key(history: GitRepo, tmp_path: Path) -> None:
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+    before = _diff(history, tmp_path, *cache)
+    (history.root / "archmetrics.toml").write_text(
+        '[tool.archmetrics.coupling]\nignore-imports = ["__future__", "shared"]\n'
+    )
+    plain = _diff(history, tmp_path, "--no-cache")
+    assert plain != before  # the import of shared no longer counts
+    assert _diff(history, tmp_path, *cache) == plain
+    assert len(_totals(tmp_path / "cache.sqlite3")) == 4
+
+
+@pytest.mark.parametrize(
+    "stored",
+    [b'{"src/client.py":[9,9,9,9]}', b"not json", b'{"src/client.py":[1,true,0,0]}', b"[]"],
+    ids=["other-numbers", "not-json", "a-bool", "a-list"],
+)
+def test_a_kept_total_that_is_not_what_was_computed_is_recomputed(
+    history: GitRepo, tmp_path: Path, stored: bytes
+) -> None:
+    """The cache file is not trusted. Numbers that parse are believed (they carry no
+    checksum; the key is the digest of their inputs), so the first case only shows that a
+    rewritten entry changes what is served; the others must be recomputed."""
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(history, tmp_path, "--no-cache")
+    _diff(history, tmp_path, "--cache-path", str(cache))
+    with sqlite3.connect(cache) as db:
+        db.execute("update totals set data = ?", (stored,))
+    served = _diff(history, tmp_path, "--cache-path", str(cache))
+    if stored.startswith(b'{"src/client.py":[9'):
+        assert served != plain
+    else:
+        assert served == plain
+
+
+def test_a_cache_made_before_the_totals_table_keeps_its_facts(
+    history: GitRepo, tmp_path: Path
+) -> None:
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(history, tmp_path, "--cache-path", str(cache))
+    with sqlite3.connect(cache) as db:
+        db.execute("drop table totals")
+        facts = db.execute("select count(*) from facts").fetchone()[0]
+    assert facts > 0
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain
+    with sqlite3.connect(cache) as db:
+        assert db.execute("select count(*) from facts").fetchone()[0] == facts
+    assert len(_totals(cache)) == 2
