@@ -19,7 +19,7 @@ from archmetrics.config import LocationSettings, Settings
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.staging import build_stage_repository
 from archmetrics.study.findings import check_findings
-from archmetrics.study.manifest import Manifest, find_manifests
+from archmetrics.study.manifest import Manifest, ManifestError, find_manifests
 from archmetrics.study.report import StudyReport, SubjectResult
 
 
@@ -72,11 +72,16 @@ def _build(manifests: Sequence[Manifest], where: Path) -> dict[Manifest, Path]:
 def run_replicate(
     request: ReplicateRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> StudyReport:
-    manifests = [
-        m for m in find_manifests(request.subjects) if not request.only or m.subject in request.only
-    ]
+    found = find_manifests(request.subjects)
+    known = sorted({m.subject for m in found})
+    unknown = [name for name in request.only if name not in known]
+    if unknown:
+        raise ManifestError(
+            f"no study subject {unknown[0]!r}; the subjects are: {', '.join(known) or 'none'}"
+        )
+    manifests = [m for m in found if not request.only or m.subject in request.only]
     if not manifests:
-        raise FileNotFoundError(f"no study subjects found under {request.subjects}")
+        raise ManifestError(f"no study subjects found under {request.subjects}")
     with tempfile.TemporaryDirectory(prefix="archmetrics-study-") as scratch:
         where = request.keep_repositories or Path(scratch)
         repos = _build(manifests, where)

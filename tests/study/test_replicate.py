@@ -121,3 +121,12 @@ def test_bad_manifests_are_named(tmp_path: Path, text: str, message: str) -> Non
     with pytest.raises(ManifestError, match=message) as error:
         load_manifest(tmp_path)
     assert "manifest.toml" in str(error.value)
+
+
+def test_an_unknown_subject_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["replicate", "--subject", "wdb", "--subject", "foo"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert (
+        err
+        == "archmetrics: error: no study subject 'foo'; the subjects are: legacy, pragmatics, wdb"
+    )
