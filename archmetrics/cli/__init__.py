@@ -19,7 +19,7 @@ from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.locations import BadPattern
 from archmetrics.cli import measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
-from archmetrics.cli.parser import build_parser
+from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
 from archmetrics.parsers import UnknownLanguage
@@ -76,6 +76,7 @@ def few_collections() -> Iterator[None]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    settle_format(args)
     try:
         if getattr(args, "jobs", 0) < 0:
             raise UsageError("--jobs must be 0 or more")

@@ -11,14 +11,49 @@ from archmetrics.cli.common import Parser
 from archmetrics.reports.charts import chart_kinds
 from archmetrics.reports.formats import Grouping, OutputFormat
 
+# What a suffix of --output means when --format is not given (an explicit --format wins).
+SUFFIX_FORMATS = {
+    ".json": "json",
+    ".md": "markdown",
+    ".markdown": "markdown",
+    ".csv": "csv",
+    ".txt": "table",
+    ".dot": "dot",
+    ".gv": "dot",
+    ".mmd": "mermaid",
+}
+
 
 def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
-    parser.add_argument("--format", choices=formats, default=formats[0], help="output format")
-    parser.add_argument("--output", "-o", type=Path, help="write the report to FILE")
+    _add_format(parser, formats)
+    parser.add_argument(
+        "--output",
+        "-o",
+        type=Path,
+        help="write the report to FILE (.json, .md or .csv picks the format unless --format)",
+    )
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     parser.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     parser.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+
+
+def _add_format(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
+    default = formats[0]
+    parser.add_argument(
+        "--format", choices=formats, default=None, help=f"output format (default: {default})"
+    )
+    parser.set_defaults(format_choices=tuple(formats), format_default=default)
+
+
+def settle_format(args: argparse.Namespace) -> None:
+    """``args.format`` when --format was not given: what the suffix of --output names, if it
+    is one of the command's formats, else the command's default."""
+    if getattr(args, "format", "") is not None or not hasattr(args, "format_default"):
+        return
+    output = getattr(args, "output", None)
+    named = SUFFIX_FORMATS.get(output.suffix.lower()) if output is not None else None
+    args.format = named if named in args.format_choices else args.format_default
 
 
 def add_chart(parser: argparse.ArgumentParser) -> None:
@@ -132,8 +167,13 @@ def build_parser() -> argparse.ArgumentParser:
     graph = commands.add_parser("graph", help="the element graph: who depends on and talks to whom")
     graph.add_argument("paths", nargs="*", type=Path, metavar="PATH", help="files or folders")
     graph.add_argument("--rev", help="the git revision to draw instead of the files on disk")
-    graph.add_argument("--format", choices=["dot", "mermaid", "json"], default="dot")
-    graph.add_argument("--output", "-o", type=Path, help="write the graph to FILE")
+    _add_format(graph, ["dot", "mermaid", "json"])
+    graph.add_argument(
+        "--output",
+        "-o",
+        type=Path,
+        help="write the graph to FILE (.dot, .mmd or .json picks the format unless --format)",
+    )
     graph.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")

@@ -80,6 +80,30 @@ def test_by_function_and_output_file(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert lines[1:] == ["p.py,python,f,4,4,2", "p.py,python,g,10,2,3"]
 
 
+@pytest.mark.parametrize(
+    ("name", "explicit", "starts"),
+    [
+        ("out.json", [], "{"),
+        ("OUT.JSON", [], "{"),
+        ("out.md", [], "## archmetrics scan"),
+        ("out.csv", [], "path,language,"),
+        ("out.json", ["--format", "csv"], "path,language,"),  # --format wins
+        ("out.report", [], "archmetrics scan: WORKTREE"),  # unknown: the default, a table
+    ],
+)
+def test_the_output_suffix_picks_the_format_unless_format_is_given(
+    tmp_path: Path, name: str, explicit: list[str], starts: str
+) -> None:
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "p.py").write_text(PY_V2)
+    out = tmp_path / name
+    assert main(["scan", str(tmp_path / "src"), "-q", "-o", str(out), *explicit]) == 0
+    text = out.read_text()
+    assert text.lstrip().startswith(starts)
+    if starts == "{":
+        assert json.loads(text)["schema"] == "archmetrics.scan/1"
+
+
 def test_bad_files_never_stop_the_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "ok.py").write_text(PY_V1)
     (tmp_path / "broken.py").write_text("def f(:\n    pass\n")
@@ -147,3 +171,11 @@ def test_nothing_to_measure_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixt
     (tmp_path / "notes.txt").write_text("no source here\n")
     assert main(["scan", str(tmp_path)]) == 2
     assert "no source files to measure" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("name", "starts"), [("g.mmd", "flowchart"), ("g.gv", "digraph")])
+def test_the_graph_output_suffix_picks_its_format(tmp_path: Path, name: str, starts: str) -> None:
+    (tmp_path / "one.c").write_text("int f(void) { return 0; }\n")
+    out = tmp_path / name
+    assert main(["graph", str(tmp_path), "--no-cache", "-o", str(out)]) == 0
+    assert out.read_text().startswith(starts)
