@@ -153,9 +153,14 @@ def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsC
                 warn(notice)
 
 
-def gate_status(failures: Sequence[GateFailure]) -> int:
-    for failure in failures:
-        print(f"archmetrics: {one_line(str(failure))}", file=sys.stderr)
+def gate_status(failures: Sequence[GateFailure], args: argparse.Namespace) -> int:
+    """Exit 1 if a gate failed, else 0. Each failure goes to stderr unless the report itself
+    showed it on stdout (a table or Markdown, every report lists its failed gates): a
+    failure is printed once, and a report written to a file or as data still names it."""
+    shown = args.output is None and args.format in (OutputFormat.TABLE, OutputFormat.MARKDOWN)
+    if not shown:
+        for failure in failures:
+            print(f"archmetrics: {one_line(str(failure))}", file=sys.stderr)
     return EXIT_GATE if failures else EXIT_OK
 
 

@@ -146,7 +146,7 @@ def series_command(args: argparse.Namespace) -> int:
         report = run_series(request, progress_for(fmt, args.quiet), cache)
     emit(render_series(report, fmt), args.output)
     write_chart(args, CompareReport(((resolve_path(Path(args.repo)).name, report),)))
-    return gate_status(report.failures)
+    return gate_status(report.failures, args)
 
 
 def compare_command(args: argparse.Namespace) -> int:
@@ -161,7 +161,7 @@ def compare_command(args: argparse.Namespace) -> int:
         report = run_compare(named, progress_for(fmt, args.quiet), cache)
     emit(render_compare(report, fmt), args.output)
     write_chart(args, report)
-    return gate_status(report.failures)
+    return gate_status(report.failures, args)
 
 
 def diff_command(args: argparse.Namespace) -> int:
@@ -174,4 +174,4 @@ def diff_command(args: argparse.Namespace) -> int:
     stage = Stage(f"{args.base}..{args.head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))
-    return gate_status(report.failures)
+    return gate_status(report.failures, args)

@@ -239,7 +239,31 @@ def test_gates_from_config(integration: GitRepo, capsys: pytest.CaptureFixture[s
         {"archmetrics.toml": 'gates = ["changes > 3"]\n[locations]\nnew = ["wdb/**"]\n'}
     )
     assert main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2"]) == 1
-    assert "gate failed: changes > 3" in capsys.readouterr().err
+    out, err = capsys.readouterr()
+    # the table on stdout names the failed gate; stderr does not repeat it
+    assert out.count("gate failed: changes > 3") == 1 and "gate failed" not in err
+
+
+@pytest.mark.parametrize(
+    ("extra", "on_stdout"),
+    [([], True), (["--format", "markdown"], True), (["--format", "json"], False)],
+)
+def test_a_failed_gate_is_printed_once(
+    integration: GitRepo,
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    extra: list[str],
+    on_stdout: bool,
+) -> None:
+    command = ["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2"]
+    gate = ["--new", "wdb/**", "--fail-on", "changes > 3", *extra]
+    assert main([*command, *gate]) == 1
+    out, err = capsys.readouterr()
+    assert (out + err).count("gate failed: changes > 3") == 1
+    assert ("gate failed" in out) is on_stdout
+    assert main([*command, *gate, "-o", str(tmp_path / "report.txt")]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("gate failed: changes > 3") == 1  # the report is a file
 
 
 @pytest.mark.parametrize(
