@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -121,6 +122,20 @@ def graph_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def revisions_to_compare(args: argparse.Namespace) -> tuple[str, str]:
+    """--base and --head, or with --from-pre-commit the range pre-commit was asked to check
+    (``pre-commit run --from-ref A --to-ref B`` sets both variables; a commit sets neither,
+    and the hook's own --base HEAD --head INDEX then measure the staged change)."""
+    if args.from_pre_commit:
+        start = os.environ.get("PRE_COMMIT_FROM_REF", "")
+        end = os.environ.get("PRE_COMMIT_TO_REF", "")
+        if start and end:
+            return start, end
+        if start or end:
+            raise UsageError("pre-commit set only one of PRE_COMMIT_FROM_REF, PRE_COMMIT_TO_REF")
+    return args.base, args.head
+
+
 def diff_request(
     args: argparse.Namespace, repo: Path, base: str = "", head: str = ""
 ) -> DiffRequest:
@@ -166,12 +181,13 @@ def compare_command(args: argparse.Namespace) -> int:
 
 def diff_command(args: argparse.Namespace) -> int:
     fmt = OutputFormat(args.format)
-    request = diff_request(args, args.repo, args.base, args.head)
+    base, head = revisions_to_compare(args)
+    request = diff_request(args, args.repo, base, head)
     settings = request.settings
     with facts_cache(args, settings) as cache:
         report = run_diff(request, progress_for(fmt, args.quiet), cache)
     emit(render_diff(report, fmt), args.output)
-    stage = Stage(f"{args.base}..{args.head}", report)
+    stage = Stage(f"{base}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))
     return gate_status(report.failures, args)

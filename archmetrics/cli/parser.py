@@ -116,6 +116,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--head", default="WORKTREE", help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
     )
     diff.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    diff.add_argument(
+        "--from-pre-commit",
+        action="store_true",
+        help="when pre-commit sets PRE_COMMIT_FROM_REF and PRE_COMMIT_TO_REF (pre-commit run "
+        "--from-ref A --to-ref B), compare those instead of --base and --head",
+    )
     add_locations(diff)
     add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])

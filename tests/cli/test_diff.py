@@ -325,3 +325,25 @@ def test_damaged_statements_in_the_cache_are_a_one_line_error(
 
 def _json(document: Any) -> bytes:
     return json.dumps(document, separators=(",", ":")).encode()
+
+
+def test_the_hook_takes_the_range_pre_commit_was_given(
+    integration: GitRepo, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    hook = ["diff", "-C", str(integration.root), "--base", "HEAD", "--head", "INDEX"]
+    hook += ["--from-pre-commit", "--format", "json"]
+    assert main(hook) == 0  # a commit: pre-commit sets no range, the staged change is measured
+    staged = json.loads(capsys.readouterr().out)
+    assert (staged["base"], staged["head"]) == ("HEAD", "INDEX")
+    assert staged["locations"]["total"]["changes"] == 0
+    monkeypatch.setenv("PRE_COMMIT_FROM_REF", "v1")
+    monkeypatch.setenv("PRE_COMMIT_TO_REF", "v2")
+    assert main(hook) == 0
+    ranged = json.loads(capsys.readouterr().out)
+    assert (ranged["base"], ranged["head"]) == ("v1", "v2")
+    assert ranged["locations"]["total"]["changes"] > 0
+    assert main([*hook[:-3], "--format", "json"]) == 0  # without the flag: as written
+    assert json.loads(capsys.readouterr().out)["base"] == "HEAD"
+    monkeypatch.delenv("PRE_COMMIT_TO_REF")
+    assert main(hook) == 2
+    assert "only one of PRE_COMMIT_FROM_REF" in capsys.readouterr().err

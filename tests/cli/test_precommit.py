@@ -71,3 +71,41 @@ def test_hook_gates_the_staged_change(repo: GitRepo, tmp_path: Path) -> None:
     assert "gate failed: added > 3 (added(total) = 5)" in second.stdout + second.stderr
     assert repo.git("diff", "--cached", "--stat") == staged  # the hook changed nothing
     assert repo.git("rev-list", "--count", "HEAD").strip() == "1"
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_hook_gates_the_range_pre_commit_is_given(repo: GitRepo, tmp_path: Path) -> None:
+    """In CI, `pre-commit run --from-ref A --to-ref B` checks the commits A..B: the hook
+    measures that range, not the (empty) staged change."""
+    repo.write(
+        {
+            ".pre-commit-config.yaml": f"repos:\n- repo: {ROOT}\n  rev: {_head()}\n"
+            "  hooks:\n  - id: archmetrics\n",
+            "archmetrics.toml": 'gates = ["added > 3"]\n',
+            "a.py": "x = 1\n",
+        }
+    )
+    base = repo.commit("first: 1 statement")
+    repo.write({"b.py": "".join(f"v{i} = {i}\n" for i in range(5))})
+    head = repo.commit("second: 5 statements, committed without the hook")
+    env = {
+        **os.environ,
+        **IDENTITY,
+        "PRE_COMMIT_HOME": str(ROOT / ".cache" / "pre-commit"),
+        "ARCHMETRICS_CACHE": str(tmp_path / "facts.sqlite3"),
+    }
+
+    def run(*argv: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [str(PRE_COMMIT), "run", "archmetrics", *argv],
+            cwd=repo.root,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
+
+    ranged = run("--from-ref", base, "--to-ref", head)
+    assert ranged.returncode == 1, ranged.stdout + ranged.stderr
+    assert "gate failed: added > 3 (added(total) = 5)" in ranged.stdout + ranged.stderr
