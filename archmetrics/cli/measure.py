@@ -36,15 +36,28 @@ from archmetrics.sources.git import tags_in_order
 from archmetrics.sources.snapshot import resolve_path
 
 
+def check_chart(args: argparse.Namespace) -> str | None:
+    """The format of the chart --chart asks for (its file ending), or None without one;
+    checked before any work: a wrong ending or a folder that is not there is a usage error
+    at once, not after the measurement."""
+    if args.chart is None:
+        return None
+    fmt: str = args.chart.suffix.lower().lstrip(".")
+    if fmt not in ("png", "svg"):
+        raise UsageError(f"{args.chart}: --chart needs a .png or .svg file")
+    folder = args.chart.parent
+    if not folder.is_dir():
+        raise UsageError(f"{args.chart}: --chart: no folder {folder}")
+    return fmt
+
+
 def write_chart(args: argparse.Namespace, report: CompareReport) -> None:
     """The chart --chart asks for, in the format its file ending names."""
-    if args.chart is None:
+    fmt = check_chart(args)
+    if fmt is None:
         return
     from archmetrics.reports.charts import render_compare_chart
 
-    fmt = args.chart.suffix.lower().lstrip(".")
-    if fmt not in ("png", "svg"):
-        raise UsageError(f"{args.chart}: --chart needs a .png or .svg file")
     data = render_compare_chart(report, args.chart_kind, fmt)
     try:
         args.chart.write_bytes(data)
@@ -153,6 +166,7 @@ def diff_request(
 
 
 def series_command(args: argparse.Namespace) -> int:
+    check_chart(args)
     fmt = OutputFormat(args.format)
     request = SeriesRequest(
         diff_request(args, args.repo), tuple(args.revisions), split(args.labels), args.root
@@ -165,6 +179,7 @@ def series_command(args: argparse.Namespace) -> int:
 
 
 def compare_command(args: argparse.Namespace) -> int:
+    check_chart(args)
     fmt = OutputFormat(args.format)
     named = []
     for text in args.repos:
@@ -180,6 +195,7 @@ def compare_command(args: argparse.Namespace) -> int:
 
 
 def diff_command(args: argparse.Namespace) -> int:
+    check_chart(args)
     fmt = OutputFormat(args.format)
     base, head = revisions_to_compare(args)
     request = diff_request(args, args.repo, base, head)

@@ -347,3 +347,30 @@ def test_the_hook_takes_the_range_pre_commit_was_given(
     monkeypatch.delenv("PRE_COMMIT_TO_REF")
     assert main(hook) == 2
     assert "only one of PRE_COMMIT_FROM_REF" in capsys.readouterr().err
+
+
+def test_a_chart_is_drawn_in_the_format_its_name_ends_with(
+    integration: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    command = ["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2", "-q"]
+    for name, starts in (("c.png", b"\x89PNG"), ("c.SVG", b"<?xml")):
+        assert main([*command, "--no-cache", "--chart", str(tmp_path / name)]) == 0
+        assert (tmp_path / name).read_bytes().startswith(starts)
+
+
+@pytest.mark.parametrize(
+    ("chart", "message"),
+    [("c.jpg", "--chart needs a .png or .svg file"), ("no/such/c.png", "--chart: no folder")],
+)
+def test_a_chart_that_cannot_be_written_is_refused_before_any_work(
+    integration: GitRepo,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    chart: str,
+    message: str,
+) -> None:
+    cache = tmp_path / "cache.sqlite3"
+    command = ["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2", "-q"]
+    assert main([*command, "--cache-path", str(cache), "--chart", str(tmp_path / chart)]) == 2
+    assert message in capsys.readouterr().err
+    assert not cache.exists()  # nothing was parsed
