@@ -9,6 +9,8 @@ from pathlib import Path, PurePosixPath
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import measure
 from archmetrics.app.progress import Progress
+from archmetrics.changeset.locations import LocationRules
+from archmetrics.changeset.model import ExcludedFile
 from archmetrics.complexity import file_metrics, totals
 from archmetrics.config import Settings
 from archmetrics.parsers import LanguageTable
@@ -87,13 +89,26 @@ def run_scan(
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
-    selected = select(snapshot, table, lambda path: _under(path, prefixes))
+    excluded: list[ExcludedFile] = []
+    rules = LocationRules((), request.settings.exclude)
+
+    def keep(path: str) -> bool:
+        """Under the requested paths and not excluded by the configuration (then listed)."""
+        if not _under(path, prefixes):
+            return False
+        reason = rules.is_excluded(path)
+        if reason is not None:
+            excluded.append(ExcludedFile(path, reason))
+        return reason is None
+
+    selected = select(snapshot, table, keep)
     if not selected and request.rev is None and prefixes and len(request.paths) == 1:
         # a folder git ignores (a virtualenv, a build tree) is read as the plain folder it is
         folder = resolve_path(request.paths[0])
         if folder.is_dir():
             root, snapshot, prefixes = folder, DirectorySnapshot(folder), ()
-            selected = select(snapshot, table)
+            excluded.clear()
+            selected = select(snapshot, table, keep)
     if not selected:
         raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
     jobs = request.jobs or request.settings.jobs
@@ -107,4 +122,5 @@ def run_scan(
         files=metrics,
         totals=totals(metrics),
         coupling=measure(facts, request.settings, root),
+        excluded=tuple(excluded),
     )

@@ -74,6 +74,7 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
         "files": [_file(f) for f in report.files],
         "totals": totals_dict(report.totals),
         "elements": coupling_rows.elements_json(report),
+        "excluded": [x.to_dict() for x in report.excluded],
     }
 
 

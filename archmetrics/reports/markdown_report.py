@@ -59,6 +59,8 @@ def render_scan(report: ScanReport, grouping: str) -> str:
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     if warnings:
         parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
+    if report.excluded:
+        parts.append("".join(f"- excluded `{x.path}`: {x.reason}\n" for x in report.excluded))
     return "\n".join(parts)
 
 

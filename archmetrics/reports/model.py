@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.changeset.model import ChangeReport, Summary
+from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.coupling import CouplingReport
 from archmetrics.facts import FileFacts, ParseWarning
@@ -27,6 +27,7 @@ class ScanReport:
     files: tuple[FileMetrics, ...]
     totals: Totals
     coupling: CouplingReport | None = None
+    excluded: tuple[ExcludedFile, ...] = ()  # left out by the configuration's `exclude`
 
     def element_rows(self) -> list[ElementRow]:
         """Per element: its files, summed λ, SLOC and v_g, and its coupling."""

@@ -87,6 +87,7 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
         table = _file_table(report)
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
+    extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
 
 

@@ -179,3 +179,22 @@ def test_the_graph_output_suffix_picks_its_format(tmp_path: Path, name: str, sta
     out = tmp_path / name
     assert main(["graph", str(tmp_path), "--no-cache", "-o", str(out)]) == 0
     assert out.read_text().startswith(starts)
+
+
+def test_the_configured_exclude_leaves_files_out_and_lists_them(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    repo.commit(
+        "v1",
+        files={
+            "pyproject.toml": '[tool.archmetrics]\nexclude = ["vendor/**"]\n',
+            "src/p.py": PY_V2,
+            "vendor/v.py": "def broken(:\n",  # would warn if it were read
+        },
+    )
+    document = _json(capsys, "scan", str(repo.root), "--format", "json", "-q")
+    assert list(_files(document)) == ["src/p.py"]
+    assert document["excluded"] == [{"path": "vendor/v.py", "reason": "exclude:vendor/**"}]
+    assert document["totals"]["warnings"] == 0  # type: ignore[index]
+    assert main(["scan", str(repo.root), "-q"]) == 0
+    assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
