@@ -111,6 +111,8 @@ def run_scan(
             selected = select(snapshot, table, keep)
     if not selected:
         raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
+    if isinstance(snapshot, DirectorySnapshot):  # the folders its walk left out, and why
+        excluded += [ExcludedFile(path, reason) for path, reason in snapshot.skipped.items()]
     jobs = request.jobs or request.settings.jobs
     limits = worker_limits(request.settings.limits, request.settings.macros)
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)

@@ -15,9 +15,19 @@ EMPTY = "EMPTY"  # the empty tree: a first integration stage has nothing before 
 WORKTREE = "WORKTREE"  # the files on disk, committed or not (untracked ones too, unless ignored)
 INDEX = "INDEX"  # what is staged
 
-SKIP_DIRS = frozenset(
-    {".git", ".hg", ".svn", ".venv", "venv", "__pycache__", "node_modules", ".tox"}
-)
+# Folders a folder snapshot does not walk, and why (listed in reports: never skipped silently).
+# A folder called ``venv`` is skipped only if it is a virtual environment (it holds
+# ``pyvenv.cfg``, or ``conda-meta``), like any other folder that holds one: a package named
+# ``venv`` is code (the standard library has one). ``.venv`` is no importable name.
+SKIP_DIRS = {
+    ".git": "version control",
+    ".hg": "version control",
+    ".svn": "version control",
+    ".venv": "virtual environment",
+    "__pycache__": "bytecode cache",
+    "node_modules": "npm packages",
+    ".tox": "tox environments",
+}
 
 
 class SourceError(Exception):
@@ -92,19 +102,20 @@ class DirectorySnapshot:
         self._within = tuple(sorted(set(within))) if "" not in within else ()
         self._hashes: dict[str, str] = {}
         self._on_disk: dict[str, str] = {}  # quoted name -> the name on disk, where they differ
+        self.skipped: dict[str, str] = {}  # folder (relative, ending in /) -> why not walked
 
     def _walk(self) -> Iterable[str]:
         if self._paths is not None:
             yield from self._paths
             return
         if not self._within:
-            yield from _walk_folder(self.root, self.root)
+            yield from _walk_folder(self.root, self.root, self.skipped)
             return
         found: set[str] = set()
         for target in self._within:
             full = self.root / target
             if full.is_dir() and not full.is_symlink():
-                found.update(_walk_folder(self.root, full))
+                found.update(_walk_folder(self.root, full, self.skipped))
             else:
                 found.add(target)
         yield from sorted(found, key=_walk_order)
@@ -127,14 +138,35 @@ class DirectorySnapshot:
             raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
 
 
-def _walk_folder(root: Path, folder: Path) -> Iterator[str]:
+def _walk_folder(root: Path, folder: Path, skipped: dict[str, str]) -> Iterator[str]:
     """The files under ``folder`` (relative to ``root``), in walk order, skipping the folders
-    no one measures (version control, virtual environments, caches)."""
+    no one measures (version control, virtual environments, caches); each skipped folder is
+    recorded in ``skipped`` with the reason."""
     for current, dirs, names in os.walk(folder):
-        dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.endswith(".egg-info"))
         rel = Path(current).relative_to(root)
+        kept = []
+        for name in sorted(dirs):
+            reason = _skip_reason(Path(current) / name, name)
+            if reason is None:
+                kept.append(name)
+            else:
+                skipped[quote_path((rel / name).as_posix()) + "/"] = reason
+        dirs[:] = kept
         for name in sorted(names):
             yield (rel / name).as_posix()
+
+
+def _skip_reason(path: Path, name: str) -> str | None:
+    """Why the folder ``path`` is not walked, or None."""
+    if name in SKIP_DIRS:
+        return SKIP_DIRS[name]
+    if name.endswith(".egg-info"):
+        return "package metadata"
+    if (path / "pyvenv.cfg").is_file():
+        return "virtual environment (pyvenv.cfg)"
+    if (path / "conda-meta").is_dir():
+        return "conda environment (conda-meta)"
+    return None
 
 
 def _walk_order(path: str) -> list[tuple[int, str]]:

@@ -198,3 +198,16 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
     assert document["totals"]["warnings"] == 0  # type: ignore[index]
     assert main(["scan", str(repo.root), "-q"]) == 0
     assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
+
+
+def test_a_plain_folder_scan_lists_the_folders_it_skipped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "venv").mkdir()
+    (tmp_path / "venv" / "__init__.py").write_text(PY_V2)  # a package named venv
+    (tmp_path / "env" / "lib").mkdir(parents=True)
+    (tmp_path / "env" / "pyvenv.cfg").write_text("home = /usr/bin\n")
+    (tmp_path / "env" / "lib" / "site.py").write_text(PY_V2)
+    document = _json(capsys, "scan", str(tmp_path), "--format", "json", "-q", "--no-cache")
+    assert list(_files(document)) == ["venv/__init__.py"]
+    assert document["excluded"] == [{"path": "env/", "reason": "virtual environment (pyvenv.cfg)"}]

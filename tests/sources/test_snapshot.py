@@ -32,3 +32,28 @@ def test_a_snapshot_within_paths_lists_only_them_in_the_order_of_the_whole_walk(
     listed = [f.path for f in within.files()]
     assert listed == [p for p in whole if p != "a/x.c" and not p.startswith("other/")]
     assert [f.path for f in DirectorySnapshot(tmp_path, within=["", "a"]).files()] == whole
+
+
+def test_a_folder_is_skipped_for_what_it_is_not_for_its_name(tmp_path: Path) -> None:
+    for path in (
+        "venv/__init__.py",  # a package named venv (the standard library has one): code
+        "env/pyvenv.cfg",  # a virtual environment, whatever its name
+        "env/lib/site.py",
+        "src/__pycache__/m.cpython-311.pyc",
+        "src/m.py",
+        "pkg.egg-info/PKG-INFO",
+        "node_modules/x/index.js",
+        "conda/conda-meta/history",  # a conda environment
+        "conda/lib/x.py",
+    ):
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text("x = 1\n")
+    snapshot = DirectorySnapshot(tmp_path)
+    assert [f.path for f in snapshot.files()] == ["src/m.py", "venv/__init__.py"]
+    assert snapshot.skipped == {
+        "conda/": "conda environment (conda-meta)",
+        "env/": "virtual environment (pyvenv.cfg)",
+        "node_modules/": "npm packages",
+        "pkg.egg-info/": "package metadata",
+        "src/__pycache__/": "bytecode cache",
+    }
