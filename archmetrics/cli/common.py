@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -139,8 +140,10 @@ def limits_salt(settings: Settings) -> str:
 def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsCache | None]:
     """The cache the flags and settings ask for (none with --no-cache or cache = false).
     Problems it recovered from are printed as it opens and, if more came up, as it closes."""
+    started = time.monotonic()
     if getattr(args, "no_cache", False) or not settings.cache:
         yield None
+        _detail(args, f"no facts cache; measured in {time.monotonic() - started:.2f} s")
         return
     with FactsCache(cache_location(args, settings), limits_salt(settings)) as cache:
         for notice in cache.notices:
@@ -151,6 +154,17 @@ def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsC
         finally:
             for notice in cache.notices[shown:]:
                 warn(notice)
+            _detail(
+                args,
+                f"facts cache {cache.path}: {cache.hits} files' facts served, {cache.misses} "
+                f"parsed; measured in {time.monotonic() - started:.2f} s",
+            )
+
+
+def _detail(args: argparse.Namespace, text: str) -> None:
+    """A line of detail on stderr with -v (never with -v absent: -q stays quiet)."""
+    if getattr(args, "verbose", False):
+        print(f"archmetrics: {one_line(text)}", file=sys.stderr)
 
 
 def gate_status(failures: Sequence[GateFailure], args: argparse.Namespace) -> int:

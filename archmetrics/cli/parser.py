@@ -95,7 +95,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"archmetrics {__version__}")
     parser.add_argument(
-        "-v", "--verbose", action="store_true", help="print the traceback of an unexpected error"
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="detail on stderr: cache hits, time taken; the traceback of an unexpected error",
     )
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     scan = commands.add_parser(

@@ -211,3 +211,19 @@ def test_a_plain_folder_scan_lists_the_folders_it_skipped(
     document = _json(capsys, "scan", str(tmp_path), "--format", "json", "-q", "--no-cache")
     assert list(_files(document)) == ["venv/__init__.py"]
     assert document["excluded"] == [{"path": "env/", "reason": "virtual environment (pyvenv.cfg)"}]
+
+
+def test_verbose_adds_cache_and_time_detail_and_quiet_stays_quiet(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "p.py").write_text(PY_V2)
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+    scan = ["scan", str(tmp_path / "src"), "-q", "--format", "json", *cache]
+    assert main([*scan, "-v"]) == 0
+    first = capsys.readouterr().err
+    assert "0 files' facts served, 1 parsed; measured in" in first
+    assert main(["-v", *scan]) == 0
+    assert "1 files' facts served, 0 parsed" in capsys.readouterr().err
+    assert main(scan) == 0
+    assert capsys.readouterr().err == ""
