@@ -48,6 +48,8 @@ def test_wheel_contents(wheel: Path) -> None:
         "archmetrics/study_subjects/wdb/soa/manifest.toml",
         "archmetrics/study_subjects/player_stub/libplayerc/playerc.h",
         "robosoa/data/descriptor.xsd",
+        "archmetrics/schemas/scan-1.schema.json",
+        "archmetrics/schemas/diff-1.schema.json",
     ):
         assert required in names, required
     assert not [n for n in names if "__pycache__" in n or n.endswith((".pyc", ".o", ".so"))]
