@@ -80,6 +80,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if getattr(args, "jobs", 0) < 0:
             raise UsageError("--jobs must be 0 or more")
+        if (getattr(args, "max_rows", None) or 0) < 0:
+            raise UsageError("--max-rows must be 0 or more")
         with few_collections():
             return COMMANDS[args.command](args)
     except CANNOT_MEASURE as error:

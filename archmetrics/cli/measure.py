@@ -173,7 +173,7 @@ def series_command(args: argparse.Namespace) -> int:
     )
     with facts_cache(args, request.diff.settings) as cache:
         report = run_series(request, progress_for(fmt, args.quiet), cache)
-    emit(render_series(report, fmt), args.output)
+    emit(render_series(report, fmt, args.max_rows), args.output)
     write_chart(args, CompareReport(((resolve_path(Path(args.repo)).name, report),)))
     return gate_status(report.failures, args)
 
@@ -202,7 +202,7 @@ def diff_command(args: argparse.Namespace) -> int:
     settings = request.settings
     with facts_cache(args, settings) as cache:
         report = run_diff(request, progress_for(fmt, args.quiet), cache)
-    emit(render_diff(report, fmt), args.output)
+    emit(render_diff(report, fmt, args.max_rows), args.output)
     stage = Stage(f"{base}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))

@@ -65,6 +65,16 @@ def add_chart(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_max_rows(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--max-rows",
+        type=int,
+        metavar="N",
+        help="Markdown: at most N changed elements, the most changed first (0: all; default: "
+        "as many as fit in a pull-request comment, 65,536 characters)",
+    )
+
+
 def add_locations(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--new", action="append", default=[], metavar="GLOB", help="new location")
     parser.add_argument(
@@ -128,6 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(diff)
     add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])
+    add_max_rows(diff)
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -138,6 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(series)
     add_chart(series)
     add_output(series, [f.value for f in OutputFormat])
+    add_max_rows(series)
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
     )

@@ -56,7 +56,11 @@ _DIFF: dict[OutputFormat, Callable[[DiffReport], str]] = {
 assert set(_DIFF) == set(OutputFormat), "every output format needs a diff renderer"
 
 
-def render_diff(report: DiffReport, fmt: OutputFormat) -> str:
+def render_diff(report: DiffReport, fmt: OutputFormat, max_rows: int | None = None) -> str:
+    """``max_rows``: Markdown's changed elements, at most that many (0: all; None: as many
+    as fit in a pull-request comment)."""
+    if fmt is OutputFormat.MARKDOWN:
+        return _safe(fmt, markdown_report.render_diff(report, max_rows))
     return _safe(fmt, _DIFF[fmt](report))
 
 
@@ -75,7 +79,9 @@ _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
 assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs series/compare"
 
 
-def render_series(report: SeriesReport, fmt: OutputFormat) -> str:
+def render_series(report: SeriesReport, fmt: OutputFormat, max_rows: int | None = None) -> str:
+    if fmt is OutputFormat.MARKDOWN:
+        return _safe(fmt, markdown_report.render_series(report, max_rows))
     return _safe(fmt, _SERIES[fmt](report))
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
+from archmetrics.changeset.model import ElementChange
 from archmetrics.reports import coupling_rows, diff_rows
 from archmetrics.reports.model import (
     LOCATION_COLUMNS,
@@ -64,8 +65,50 @@ def render_scan(report: ScanReport, grouping: str) -> str:
     return "\n".join(parts)
 
 
-def render_diff(report: DiffReport) -> str:
-    """A pull-request comment: verdict line, summary table, changed elements, notes."""
+COMMENT_LIMIT = 65_536  # characters GitHub takes in one pull-request comment
+_ROOM = 1_000  # for the lines that say what was left out
+_SHOWN_EXCLUDED = 20
+
+
+def _worst_first(change: ElementChange) -> tuple[int, int, str]:
+    """Most changed statements first, then the largest complexity change, then by name."""
+    delta_vg = (change.post.vg if change.post else 0) - (change.pre.vg if change.pre else 0)
+    return (-(change.added + change.removed + change.modified), -abs(delta_vg), change.element)
+
+
+def _elements(changed: list[ElementChange], budget: int, max_rows: int | None) -> list[str]:
+    """The changed elements' table, worst first: at most ``max_rows`` rows (0: all), or by
+    default as many as fit in ``budget`` characters, and a line saying what was left out."""
+    rows = [diff_rows.element_row(e) for e in sorted(changed, key=_worst_first)]
+    header, align = list(diff_rows.ELEMENT_HEADER), "lll" + "r" * 11
+    if max_rows:
+        shown = rows[:max_rows]
+    elif max_rows == 0:
+        shown = rows
+    else:  # the most rows whose table fits (a table grows with its rows)
+        low, high = 0, len(rows)
+        while low < high:
+            middle = (low + high + 1) // 2
+            if len(table(header, rows[:middle], align)) <= budget:
+                low = middle
+            else:
+                high = middle - 1
+        shown = rows[:low]
+    parts = [f"<details><summary>{len(changed)} changed elements</summary>\n"]
+    parts.append(table(header, shown, align))
+    if len(shown) < len(rows):
+        parts.append(
+            f"{len(rows) - len(shown)} more changed elements not shown (the most changed are"
+            " above; `--max-rows 0` shows them all, `--format json` has every element)\n"
+        )
+    parts.append("</details>\n")
+    return parts
+
+
+def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
+    """A pull-request comment: verdict line, summary table, changed elements (worst first),
+    notes. By default the comment fits GitHub's limit (``COMMENT_LIMIT``): the elements that
+    do not fit are counted, not shown; ``max_rows``: at most that many (0: every one)."""
     total = report.change.total
     verdict = (
         f"**{len(report.failures)} gate(s) failed**"
@@ -78,24 +121,25 @@ def render_diff(report: DiffReport) -> str:
         f"E = {diff_rows.number(total.cost)} · {verdict}\n",
         table(["metric", "eq.", *LOCATION_COLUMNS], diff_rows.summary_rows(report), "llrrrr"),
     ]
-    changed = [e for e in report.change.elements if e.status.value != "unchanged"]
-    if changed:
-        rows = [diff_rows.element_row(e) for e in changed]
-        parts.append(f"<details><summary>{len(changed)} changed elements</summary>\n")
-        parts.append(table(list(diff_rows.ELEMENT_HEADER), rows, "lll" + "r" * 11))
-        parts.append("</details>\n")
     bullets = [f"- {f}" for f in report.failures]
     bullets += [f"- note {n}" for n in diff_rows.notes(report)]
-    bullets += [f"- excluded `{x.path}`: {x.reason}" for x in report.change.excluded]
+    excluded = report.change.excluded
+    bullets += [f"- excluded `{x.path}`: {x.reason}" for x in excluded[:_SHOWN_EXCLUDED]]
+    if len(excluded) > _SHOWN_EXCLUDED:
+        more = len(excluded) - _SHOWN_EXCLUDED
+        bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
-    if bullets:
-        parts.append("\n".join(bullets) + "\n")
-    return "\n".join(parts)
+    tail = ["\n".join(bullets) + "\n"] if bullets else []
+    changed = [e for e in report.change.elements if e.status.value != "unchanged"]
+    if changed:
+        budget = COMMENT_LIMIT - _ROOM - len("\n".join(parts + tail))
+        parts += _elements(changed, budget, max_rows)
+    return "\n".join(parts + tail)
 
 
-def render_series(report: SeriesReport) -> str:
+def render_series(report: SeriesReport, max_rows: int | None = None) -> str:
     parts = [
-        render_diff(s.report).replace("## archmetrics:", f"## stage {s.label}:", 1)
+        render_diff(s.report, max_rows).replace("## archmetrics:", f"## stage {s.label}:", 1)
         for s in report.stages
     ]
     rows = [r[1:] for r in diff_rows.trend_rows(report)]

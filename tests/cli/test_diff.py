@@ -374,3 +374,43 @@ def test_a_chart_that_cannot_be_written_is_refused_before_any_work(
     assert main([*command, "--cache-path", str(cache), "--chart", str(tmp_path / chart)]) == 2
     assert message in capsys.readouterr().err
     assert not cache.exists()  # nothing was parsed
+
+
+@pytest.fixture
+def many_changes(repo: GitRepo) -> GitRepo:
+    """300 elements with long names, element k gaining k % 7 + 1 statements."""
+    folder = "pkg/" + "a_rather_long_folder_name_" * 6
+    names = [f"{folder}/module_number_{k:03d}_with_a_long_name.py" for k in range(300)]
+    repo.commit("v1", tag="v1", files={name: "x = 0\n" for name in names})
+    changed = {
+        name: "x = 0\n" + "".join(f"y{j} = {j}\n" for j in range(k % 7 + 1))
+        for k, name in enumerate(names)
+    }
+    repo.commit("v2", tag="v2", files=changed)
+    return repo
+
+
+def _markdown(repo: GitRepo, capsys: pytest.CaptureFixture[str], *extra: str) -> str:
+    argv = ["diff", "-C", str(repo.root), "--base", "v1", "--head", "v2", "-q"]
+    assert main([*argv, "--format", "markdown", "--no-cache", *extra]) == 0
+    return capsys.readouterr().out
+
+
+def _rows(markdown: str) -> list[str]:
+    return [line for line in markdown.splitlines() if line.startswith("| pkg/")]
+
+
+def test_markdown_fits_a_pull_request_comment_and_says_what_it_left_out(
+    many_changes: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    everything = _markdown(many_changes, capsys, "--max-rows", "0")
+    assert len(_rows(everything)) == 300 and len(everything) > 65_536  # too long for GitHub
+    fitted = _markdown(many_changes, capsys)
+    rows = _rows(fitted)
+    assert len(fitted) <= 65_536 and 0 < len(rows) < 300
+    assert f"{300 - len(rows)} more changed elements not shown" in fitted
+    added = [int(row.split("|")[8]) for row in rows]  # the "added" column
+    assert added == sorted(added, reverse=True) and added[0] == 7  # the most changed first
+    five = _markdown(many_changes, capsys, "--max-rows", "5")
+    assert len(_rows(five)) == 5 and "295 more changed elements not shown" in five
+    assert main(["diff", "-C", str(many_changes.root), "--max-rows", "-1"]) == 2
