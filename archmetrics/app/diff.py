@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import archmetrics
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import Progress
@@ -22,7 +20,7 @@ from archmetrics.facts import FileFacts, ParseWarning
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import DiffReport
 from archmetrics.sources import Snapshot, git, open_snapshot
-from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.cache import FactsCache, code_fingerprint
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,16 +70,18 @@ def coupling_values(
         and not rules.is_excluded(f.path)
         and not (rules.exclude_generated and f.generated)
     ]
-    key = None
-    if cache is not None and blobs is not None:
-        key = coupling_key(measured, blobs, options, packs, cache.fingerprint)
-    if key is not None and cache is not None:
+    key = (
+        None
+        if cache is None or blobs is None
+        else coupling_key(measured, blobs, options, packs, cache.fingerprint)
+    )
+    if cache is not None and key is not None:
         known = _read_coupling(cache.get_total(key))
         if known is not None:
             return known
     report = measure_coupling(measured, options, packs)
     values = {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
-    if key is not None and cache is not None:
+    if cache is not None and key is not None:
         cache.put_total(key, json.dumps(values, separators=(",", ":")).encode())
     return values
 
@@ -103,20 +103,8 @@ def coupling_key(
         if not blob:
             return None
         files.append((facts.path, blob, facts.language))
-    document = ["coupling/1", _code_fingerprint(), parser, repr(options), repr(packs), files]
+    document = ["coupling/1", code_fingerprint(), parser, repr(options), repr(packs), files]
     return hashlib.sha256(json.dumps(document).encode()).hexdigest()
-
-
-@functools.cache
-def _code_fingerprint() -> str:
-    """A digest of archmetrics's own source: any change to how coupling is computed (or to
-    anything it uses) is a new key."""
-    root = Path(__file__).resolve().parents[1]
-    digest = hashlib.sha256(archmetrics.__version__.encode())
-    for path in sorted(root.rglob("*.py")):
-        digest.update(path.relative_to(root).as_posix().encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()
 
 
 def _read_coupling(data: bytes | None) -> dict[str, Coupling] | None:

@@ -89,29 +89,22 @@ def run_scan(
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
-    excluded: list[ExcludedFile] = []
-    rules = LocationRules((), request.settings.exclude)
-
-    def keep(path: str) -> bool:
-        """Under the requested paths and not excluded by the configuration (then listed)."""
-        if not _under(path, prefixes):
-            return False
-        reason = rules.is_excluded(path)
-        if reason is not None:
-            excluded.append(ExcludedFile(path, reason))
-        return reason is None
-
-    selected = select(snapshot, table, keep)
+    selected = select(snapshot, table, lambda path: _under(path, prefixes))
     if not selected and request.rev is None and prefixes and len(request.paths) == 1:
         # a folder git ignores (a virtualenv, a build tree) is read as the plain folder it is
         folder = resolve_path(request.paths[0])
         if folder.is_dir():
             root, snapshot, prefixes = folder, DirectorySnapshot(folder), ()
-            excluded.clear()
-            selected = select(snapshot, table, keep)
+            selected = select(snapshot, table)
+    # the configuration's `exclude` leaves files out; they are listed, with the folders a
+    # plain folder's walk left out
+    rules = LocationRules((), request.settings.exclude)
+    judged = [(item, rules.is_excluded(item.file.path)) for item in selected]
+    excluded = [ExcludedFile(item.file.path, why) for item, why in judged if why]
+    selected = tuple(item for item, why in judged if why is None)
     if not selected:
         raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
-    if isinstance(snapshot, DirectorySnapshot):  # the folders its walk left out, and why
+    if isinstance(snapshot, DirectorySnapshot):
         excluded += [ExcludedFile(path, reason) for path, reason in snapshot.skipped.items()]
     jobs = request.jobs or request.settings.jobs
     limits = worker_limits(request.settings.limits, request.settings.macros)

@@ -57,15 +57,29 @@ _T = TypeVar("_T")
 _PARSING_LIBRARIES = ("libcst", "tree-sitter", "tree-sitter-c", "tree-sitter-cpp")
 
 
+def _source_digest(paths: Iterable[Path]) -> hashlib._Hash:
+    """A running hash of archmetrics's version and of ``paths``' names and bytes, in order."""
+    root = Path(archmetrics.__file__).parent
+    digest = hashlib.sha256(archmetrics.__version__.encode())
+    for path in sorted(paths):
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest
+
+
+@cache
+def code_fingerprint() -> str:
+    """A hash of archmetrics's whole source: what a total kept in the cache (a tree's
+    coupling) may depend on."""
+    return _source_digest(Path(archmetrics.__file__).parent.rglob("*.py")).hexdigest()
+
+
 @cache
 def parser_fingerprint() -> str:
     """A hash of what makes facts: the parsers package, facts.py, the Python version (its
     ``ast`` reads Python files) and the versions of the parsing libraries."""
     root = Path(archmetrics.__file__).parent
-    digest = hashlib.sha256(archmetrics.__version__.encode())
-    for path in sorted([root / "facts.py", *(root / "parsers").glob("*.py")]):
-        digest.update(path.name.encode())
-        digest.update(path.read_bytes())
+    digest = _source_digest([root / "facts.py", *(root / "parsers").glob("*.py")])
     digest.update(str(codec.FORMAT).encode())
     digest.update(sys.version.encode())
     for library in _PARSING_LIBRARIES:
