@@ -108,7 +108,7 @@ class CallSites:
         kind = node.type
         if kind == "identifier":
             return Argument(raw.decode("utf-8", "replace"))
-        written = self._text(start, end, _argument_text, raw)
+        written = _argument_text(raw)  # (no long call inside: not cut)
         value: Literal = None
         is_literal = False
         if kind == "concatenated_string":
@@ -126,13 +126,11 @@ class CallSites:
             is_literal, value = literal(kind, raw)
         return Argument(written, value, is_literal)
 
-    def _text(
-        self, start: int, end: int, read: Callable[[bytes], str], raw: bytes | None = None
-    ) -> str:
-        """``read`` of bytes ``start:end`` (``raw``, if given); cut if it holds a long call,
-        and then read by growing windows from its start, not whole."""
+    def _text(self, start: int, end: int, read: Callable[[bytes], str]) -> str:
+        """``read`` of bytes ``start:end``; cut if it holds a long call, and then read by
+        growing windows from its start, not whole."""
         if not self._holds_call(start, end):
-            return read(self._data[start:end] if raw is None else raw)
+            return read(self._data[start:end])
         found = self._cut.get((start, read))
         if found is not None and found[0] <= end:
             return found[1]  # the same first window: the same cut

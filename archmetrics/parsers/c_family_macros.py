@@ -15,6 +15,7 @@ only *between declarations* (outside the function bodies of the first parse), wh
 from __future__ import annotations
 
 import bisect
+import functools
 import re
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -152,8 +153,8 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
         # void f(int * BROTLI_RESTRICT self, FUNC& HWY_RESTRICT g)   const T* const
         # HWY_RESTRICT p)   T* HWY_RESTRICT pos = x;   (after a `*` or `&`: no expression
         # has a word after an operand there, so before the first parse)
-        Rule((_scan(rb"[*&]", rb"[*&]\s*+(?:(?:const|volatile)\s++)*+(" + macro
-                    + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[=;])"),), before=True),
+        Rule(_keywords((rb"\*", b"&"), rb"\s*+(?:(?:const|volatile)\s++)*+(" + macro
+                       + rb")(?=\s++[A-Za-z_]\w*+\s*+[,)\[=;])"), before=True),
         # ABSL_CONST_INIT static T x;   ABSL_MUST_USE_RESULT inline int f(   (macros heading
         # a declaration, before a keyword that begins one)
         Rule(_at_line_start(rb"[ \t]*+((?>" + macro + _ARGS + rb"?+[ \t]++)++)(?=" + _LEADING
@@ -220,6 +221,7 @@ _TYPE_WORDS = re.compile(
 _RULES: dict[MacroNames, tuple[Rule, ...]] = {}
 _WORD_BYTE = [chr(byte).isalnum() or byte == ord("_") for byte in range(128)] + [True] * 128
 _LOOK_AHEAD = 4096  # bytes past a span of ``near`` a rule may read to decide a match in it
+_LONGEST_START = 16  # bytes of the longest literal a rule begins with (``static``, ``\n``)
 # A literal or comment left open runs to the end of its line (strings) or of the file (raw
 # strings, block comments), as a compiler would read on: every byte is scanned once, never
 # once per quote or `/*` that follows (a file of 100,000 `/*` took minutes).
@@ -228,6 +230,7 @@ _LITERALS = re.compile(
     rb'|"(?:\\.|[^"\\\n])*+(?:"|(?=\n)|\Z)|\'(?:\\.|[^\'\\\n])*+(?:\'|(?=\n)|\Z)'
     rb"|//[^\n]*+|/\*(?:[^*]|\*(?!/))*+(?:\*/|\Z)"
 )
+_LITERAL_EDGE = re.compile(rb"[\"'/\\\n]")
 _ENUM_OR_VALUE = re.compile(rb"(?:\benum\b[^;{}]*|=\s*)\{\s*$")
 _CONTINUING = frozenset(b",(=|&+-*/?:<[!~%^")
 
@@ -261,6 +264,10 @@ class _Ranges:
 _DIRECTIVE = _at_line_start(rb"[ \t]*+\#(?:[^\\\n]++|\\(?:\r?\n|.))*+")
 
 
+# A file's spans are asked for several times while it is read (the first parse's macros, the
+# rereading's, its #if groups), mostly of the same bytes: the last few files' are kept
+# (bytes keep their hash, and equal bytes give equal spans).
+@functools.lru_cache(maxsize=4)
 def directive_spans(data: bytes) -> _Ranges:
     """The byte ranges of ``data``'s preprocessor directives, continuation lines included."""
     after_newline, at_start = _DIRECTIVE
@@ -269,6 +276,7 @@ def directive_spans(data: bytes) -> _Ranges:
     return _Ranges(spans + [found.span() for found in after_newline.pattern.finditer(data)])
 
 
+@functools.lru_cache(maxsize=4)
 def literal_spans(data: bytes) -> _Ranges:
     """The byte ranges of ``data``'s string and character literals and comments."""
     return _Ranges([found.span() for found in _LITERALS.finditer(data)])
@@ -289,7 +297,7 @@ def _matches(scan: Scan, data: bytes, spans: list[tuple[int, int]]) -> Iterator[
                 yield found
             continue
         resume = start
-        for candidate in scan.start.finditer(data, start, limit):
+        for candidate in scan.start.finditer(data, start, min(size, end + _LONGEST_START)):
             at = candidate.start()
             if at >= end:
                 break
@@ -328,15 +336,21 @@ def blank_macros(
         return data
     in_body = _Ranges(list(bodies))
     wanted = _Ranges(spans) if spans is not None else None
-    literal = literal_spans(data)
+    literal: _Ranges | None = None
     directive = directive_spans(data)
     out = bytearray(data)
     for rule, found in hits:
         start, end = found.span(found.lastindex or 1)  # the group that matched
-        if start in literal or (rule.between and start in in_body):
+        if rule.between and start in in_body:
             continue
         if wanted is not None and start not in wanted:
             continue
+        # blanks inside a comment or a literal change no parse, unless they reach its edge:
+        # only a group holding a quote, a slash, a backslash or a line end is checked
+        if _LITERAL_EDGE.search(data, start, end) is not None:
+            literal = literal_spans(data) if literal is None else literal
+            if start in literal:
+                continue
         begins = found.start() + (data[found.start() : found.start() + 1] == b"\n")
         if start in directive or begins in directive:  # where the match or its group starts
             continue

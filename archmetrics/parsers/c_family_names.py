@@ -39,7 +39,12 @@ def in_order(nodes: Iterable[Node]) -> list[Node]:
     that start at the same byte (``f(a)(b)`` and ``f(a)``, an ERROR inside an ERROR) in an
     order that varies with what the process parsed before, and facts must not.
     """
-    return sorted(nodes, key=lambda n: (n.start_byte, -n.end_byte, n.type))
+    nodes = list(nodes)
+    starts = [node.start_byte for node in nodes]
+    if len(set(starts)) < len(starts):  # two start together: the full key (rare, dearer)
+        return sorted(nodes, key=lambda n: (n.start_byte, -n.end_byte, n.type))
+    order = sorted(range(len(nodes)), key=starts.__getitem__)
+    return [nodes[index] for index in order]
 
 
 def span(node: Node) -> Span:

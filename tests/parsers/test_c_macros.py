@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from archmetrics.facts import FileFacts, Span
-from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
+from archmetrics.facts import FileFacts, Language, Span
+from archmetrics.parsers.c_family_grammar import grammar
+from archmetrics.parsers.c_family_macros import MacroNames, blank_macros, literal_spans
 from tests.harness import complexities, facts_of
 
 
@@ -152,8 +153,20 @@ def test_blanking_keeps_every_offset_and_line() -> None:
     assert b"FOO_API" not in blanked and b"LOCKS" not in blanked
 
 
-def test_a_macro_inside_a_string_or_comment_is_left_alone() -> None:
+def test_a_macro_inside_a_string_or_comment_leaves_the_literal_whole() -> None:
+    # blanks inside a literal change no parse (texts are read from the bytes as written);
+    # what must hold is every literal's extent
     source = b'const char *s = "class FOO_API Proxy {";\n/* class BAR_API X { */\n'
+    blanked = blank_macros(source, first=True)
+    assert literal_spans(blanked)._spans == literal_spans(source)._spans
+    parser = grammar(Language.CPP).parser
+    assert str(parser.parse(blanked).root_node) == str(parser.parse(source).root_node)
+
+
+def test_a_macro_run_that_leaves_a_comment_is_left_alone() -> None:
+    # the group would run from inside a line comment past its end: blanking it would change
+    # the code after the comment
+    source = b"int x; // see class FOO_API\nProxy : Base { };\n"
     assert blank_macros(source, first=True) == source
 
 
