@@ -13,7 +13,7 @@ from __future__ import annotations
 import importlib
 import re
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 from tree_sitter import Language as TSLanguage
@@ -132,15 +132,13 @@ _NEAR = 64  # differing spans closer than this are one edit
 
 def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
     """A copy of ``tree`` (of ``before``) told where ``after``, as long, differs from it."""
-    size = len(before)
-    differ = (int.from_bytes(before, "big") ^ int.from_bytes(after, "big")).to_bytes(size, "big")
     copy = tree.copy()
     spans: list[list[int]] = []
-    for found in _DIFFERENT.finditer(differ):
-        if spans and found.start() - spans[-1][1] < _NEAR:
-            spans[-1][1] = found.end()
+    for start, end in _differing(before, after):
+        if spans and start - spans[-1][1] < _NEAR:
+            spans[-1][1] = end
         else:
-            spans.append([found.start(), found.end()])
+            spans.append([start, end])
     row, last = 0, 0  # the points (row, column), counted along the file once
     for start, end in spans:
         points = []
@@ -154,6 +152,22 @@ def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
 
 
 _DIFFERENT = re.compile(rb"[^\x00]+")
+_BLOCK = 4096  # bytes compared at a time: equal blocks (most of a file) are skipped at once
+
+
+def _differing(before: bytes, after: bytes) -> Iterator[tuple[int, int]]:
+    """The byte ranges where ``before`` and ``after`` (as long) differ, in order; ranges
+    that meet at a block's edge come as two."""
+    for offset in range(0, len(before), _BLOCK):
+        stop = offset + _BLOCK
+        if before[offset:stop] == after[offset:stop]:
+            continue
+        size = min(stop, len(before)) - offset
+        differ = int.from_bytes(before[offset:stop], "big") ^ int.from_bytes(
+            after[offset:stop], "big"
+        )
+        for found in _DIFFERENT.finditer(differ.to_bytes(size, "big")):
+            yield offset + found.start(), offset + found.end()
 
 
 def errors_and_missing(root: Node) -> dict[str, list[Node]]:
