@@ -134,7 +134,7 @@ def edited(tree: Tree, before: bytes, after: bytes) -> Tree:
     """A copy of ``tree`` (of ``before``) told where ``after``, as long, differs from it."""
     copy = tree.copy()
     spans: list[list[int]] = []
-    for start, end in _differing(before, after):
+    for start, end in differing(before, after):
         if spans and start - spans[-1][1] < _NEAR:
             spans[-1][1] = end
         else:
@@ -155,7 +155,7 @@ _DIFFERENT = re.compile(rb"[^\x00]+")
 _BLOCK = 4096  # bytes compared at a time: equal blocks (most of a file) are skipped at once
 
 
-def _differing(before: bytes, after: bytes) -> Iterator[tuple[int, int]]:
+def differing(before: bytes, after: bytes) -> Iterator[tuple[int, int]]:
     """The byte ranges where ``before`` and ``after`` (as long) differ, in order; ranges
     that meet at a block's edge come as two."""
     for offset in range(0, len(before), _BLOCK):

@@ -8,9 +8,11 @@ where nothing was lost.
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from archmetrics.facts import FileFacts, Language, Span
-from archmetrics.parsers.c_family_grammar import grammar
+from archmetrics.parsers.c_family_grammar import differing, grammar
 from archmetrics.parsers.c_family_macros import MacroNames, blank_macros, literal_spans
 from tests.harness import complexities, facts_of
 
@@ -952,3 +954,31 @@ def test_macros_heading_an_explicit_instantiation_are_blanked_before_the_first_p
     assert blank_macros(text, first=True) == text.replace(b"NPY_NO_EXPORT", b" " * 13)
     kept = b"\nreturn FOO bar(x);\nelse BAR baz(y);\n"  # statements, not declarations
     assert blank_macros(kept, first=True) == kept
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.binary(max_size=9000),
+    st.lists(st.tuples(st.integers(0, 9000), st.integers(1, 5000)), max_size=6),
+)
+def test_the_spans_a_rereading_edits_are_exactly_where_the_bytes_differ(
+    before: bytes, blanks: list[tuple[int, int]]
+) -> None:
+    # compared a block at a time; the reference: every maximal run of differing bytes
+    after = bytearray(before)
+    for start, length in blanks:
+        after[start : start + length] = b" " * len(after[start : start + length])
+    runs: list[tuple[int, int]] = []
+    for offset, (a, b) in enumerate(zip(before, after, strict=True)):
+        if a != b:
+            if runs and runs[-1][1] == offset:
+                runs[-1] = (runs[-1][0], offset + 1)
+            else:
+                runs.append((offset, offset + 1))
+    found: list[tuple[int, int]] = []
+    for start, end in differing(before, bytes(after)):
+        if found and found[-1][1] == start:  # a run across a block's edge comes as two
+            found[-1] = (found[-1][0], end)
+        else:
+            found.append((start, end))
+    assert found == runs
