@@ -206,6 +206,16 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
                                   rb"\s*+|\s++))(?=[A-Za-z_]\w*+\s*+=[^=])"), word=True),
         # ABSL_INTERNAL_TRY {   (a macro alone before a block: a `try` or a scope, say)
         Rule(_at_line_start(rb"[ \t]*+(" + macro + rb")[ \t]*+(?=\{)")),
+        # template <class T, EnableIf<(N <= 1)>* = nullptr>   void f(Foo* = nullptr)   (an
+        # unnamed pointer or reference parameter with a default, which tree-sitter-cpp's
+        # grammar lacks: the `*` or `&` blanked, a parameter of the pointee's type is left;
+        # `* =` with a blank between is no operator, `*=` is)
+        Rule((_scan(rb"\*", rb"(\*[*&]*+)(?=[ \t]++=[^=])"),
+              _scan(b"&", rb"(&[*&]*+)(?=[ \t]++=[^=])")), before=True),
+        # const __vector unsigned char k = {...};   (a compiler's keyword, reserved `__`
+        # spelling, before a built-in type: AltiVec's `__vector`)
+        Rule((_scan(b"__", rb"(__[A-Za-z]\w*+)(?=\s++(?:__[A-Za-z]\w*+\s++)*+" + _BUILTIN
+                    + rb")"),), word=True),
     )  # fmt: skip
 
 
@@ -346,8 +356,9 @@ def blank_macros(
         if wanted is not None and start not in wanted:
             continue
         # blanks inside a comment or a literal change no parse, unless they reach its edge:
-        # only a group holding a quote, a slash, a backslash or a line end is checked
-        if _LITERAL_EDGE.search(data, start, end) is not None:
+        # only a group holding or touching a quote, a slash, a backslash or a line end is
+        # checked (touching: the `*` of a `/*` or a `*/`)
+        if _LITERAL_EDGE.search(data, max(0, start - 1), end + 1) is not None:
             literal = literal_spans(data) if literal is None else literal
             if start in literal:
                 continue
