@@ -6,13 +6,23 @@ import hashlib
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from importlib import metadata
 from pathlib import Path
 
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import Progress
 from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
+from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.changeset.statement_diff import (
+    CHANGE_RECORD,
+    FileChange,
+    change_from_record,
+    change_record,
+    diff_files,
+    same_statements,
+)
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, group_elements, measure_coupling
 from archmetrics.coupling.rules import RuleSet
@@ -21,6 +31,8 @@ from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import DiffReport
 from archmetrics.sources import Snapshot, git, open_snapshot
 from archmetrics.sources.cache import FactsCache, code_fingerprint
+
+_RAPIDFUZZ = metadata.version("rapidfuzz")
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,6 +142,60 @@ def _read_coupling(data: bytes | None) -> dict[str, Coupling] | None:
     return values
 
 
+def cached_differ(
+    cache: FactsCache, pre_blobs: Mapping[str, str], post_blobs: Mapping[str, str]
+) -> Differ:
+    """``diff_files`` with each file pair's change kept in ``cache`` under a digest of what
+    decides it (:func:`change_key`): a diff that meets the same two blobs again (the next
+    diff of a branch, a warm rerun, each stage of a series) reads neither file's statements."""
+
+    def diff(pre: FileFacts | None, post: FileFacts | None) -> FileChange:
+        pre_path, post_path = pre.path if pre else None, post.path if post else None
+        if pre and post and same_statements(pre.statements, post.statements):
+            return diff_files(pre, post)  # known equal without reading them: nothing to keep
+        key = change_key(pre, post, pre_blobs, post_blobs, cache.fingerprint)
+        if key is not None:
+            data = cache.get_total(key)
+            if data is not None:
+                try:
+                    known = change_from_record(json.loads(data), pre_path, post_path)
+                except ValueError:
+                    known = None
+                if known is not None:
+                    return known
+        change = diff_files(pre, post)
+        if key is not None:
+            record = json.dumps(change_record(change), separators=(",", ":"), ensure_ascii=False)
+            cache.put_total(key, record.encode("utf-8", "surrogatepass"))
+        return change
+
+    return diff
+
+
+def change_key(
+    pre: FileFacts | None,
+    post: FileFacts | None,
+    pre_blobs: Mapping[str, str],
+    post_blobs: Mapping[str, str],
+    parser: str,
+) -> str | None:
+    """A digest of what decides a file pair's change: this archmetrics's code (the pairing
+    rule), rapidfuzz's version (its similarity), and each side's blob and language under the
+    ``parser`` fingerprint of the facts cache, named by the record's kind (the cache's
+    ``totals`` table holds trees' coupling too). None if a side's blob is unknown."""
+    sides: list[object] = []
+    for facts, blobs in ((pre, pre_blobs), (post, post_blobs)):
+        if facts is None:
+            sides.append(None)
+            continue
+        blob = blobs.get(facts.path)
+        if not blob:
+            return None
+        sides.append([blob, facts.language])
+    document = [CHANGE_RECORD, code_fingerprint(), _RAPIDFUZZ, parser, sides]
+    return f"{CHANGE_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
+
+
 def pair_files(
     pre: Sequence[FileFacts], post: Sequence[FileFacts], renames: dict[str, str]
 ) -> list[FilePair]:
@@ -195,6 +261,7 @@ def measure_change(
         coupling_values(pre, rules, options, packs, cache, pre_blobs),
         coupling_values(post, rules, options, packs, cache, post_blobs),
         dynamic_pre_zero=request.dynamic_pre_zero,
+        diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
     return change, _warnings(pre, post)
 

@@ -13,6 +13,8 @@
   ``CouplingReport``); None when coupling was not measured (zeros, flagged in the notes).
 * ``dynamic_pre_zero``: apply the thesis convention (p. 100) that d_a and d_e are 0 before the
   integration, instead of the values measured on the pre tree (the default).
+* ``diff``: how a file pair's statement change is found (``diff_files``, or a function that
+  gives what it gives: the application keeps changes in the cache by the files' blobs).
 
 Excluded files count nowhere and are listed with their reason: a side whose path matches an
 exclude glob or whose facts say ``generated`` is dropped alone; a pair with a side no parser
@@ -25,7 +27,14 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 
 from archmetrics.changeset.cost import Sums, location_summary, total_summary
-from archmetrics.changeset.elements import ElementLike, Side, assign, element_change, element_index
+from archmetrics.changeset.elements import (
+    Differ,
+    ElementLike,
+    Side,
+    assign,
+    element_change,
+    element_index,
+)
 from archmetrics.changeset.locations import Location, LocationRules
 from archmetrics.changeset.model import (
     ChangeReport,
@@ -35,6 +44,7 @@ from archmetrics.changeset.model import (
     FilePair,
     Metrics,
 )
+from archmetrics.changeset.statement_diff import diff_files
 from archmetrics.coupling.elements import group_elements
 from archmetrics.coupling.model import CouplingReport
 from archmetrics.facts import FileFacts
@@ -123,6 +133,7 @@ def compute_change(
     coupling_post: Mapping[str, Coupling] | None,
     *,
     dynamic_pre_zero: bool = False,
+    diff: Differ = diff_files,
 ) -> ChangeReport:
     """Chapter 6 metrics of one comparison: per location, total, per element, exclusions."""
     kept, excluded = _partition(pairs, rules)
@@ -135,7 +146,7 @@ def compute_change(
     notes: dict[Location, list[str]] = {loc: [] for loc in Location}
     for name in sorted(groups):
         element_notes: list[str] = []
-        change = element_change(name, groups[name], rules, sides, element_notes)
+        change = element_change(name, groups[name], rules, sides, element_notes, diff)
         changes.append(change)
         notes[change.location] += element_notes
     common = _side_notes(sides)

@@ -8,14 +8,18 @@ the old element and an addition to the new one, so each element's before/after s
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 from archmetrics.changeset.locations import Location, LocationRules
 from archmetrics.changeset.model import Coupling, ElementChange, FilePair, Metrics, Status
-from archmetrics.changeset.statement_diff import diff_files
+from archmetrics.changeset.statement_diff import FileChange, diff_files
 from archmetrics.facts import FileFacts
+
+# How a file pair's change is found: diff_files, or a function that gives what it would
+# give (the application's, which keeps changes in the cache by the files' blobs)
+Differ = Callable[[FileFacts | None, FileFacts | None], FileChange]
 
 
 class ElementLike(Protocol):
@@ -118,9 +122,10 @@ def element_change(
     rules: LocationRules,
     sides: tuple[Side, Side],
     notes: list[str],
+    diff: Differ = diff_files,
 ) -> ElementChange:
     """The change set of one element: statement diffs of its files, status, M before and after."""
-    file_changes = tuple(diff_files(p.pre, p.post) for p in sorted(pairs, key=lambda p: p.path))
+    file_changes = tuple(diff(p.pre, p.post) for p in sorted(pairs, key=lambda p: p.path))
     for change in file_changes:
         if change.approximate:
             notes.append(

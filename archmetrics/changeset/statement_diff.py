@@ -28,10 +28,10 @@ from difflib import SequenceMatcher
 from enum import StrEnum
 
 from archmetrics.changeset.pairing import pair, similarity, tokens
-from archmetrics.facts import FileFacts, Statement, kept_digest
+from archmetrics.facts import FileFacts, Span, Statement, kept_digest
 
-__all__ = ["Action", "FileChange", "StatementChange", "diff_files", "diff_statements",
-           "similarity", "tokens"]  # fmt: skip
+__all__ = ["Action", "FileChange", "StatementChange", "change_from_record", "change_record",
+           "diff_files", "diff_statements", "same_statements", "similarity", "tokens"]  # fmt: skip
 
 
 class Action(StrEnum):
@@ -112,6 +112,15 @@ def _flag_moves(changes: list[StatementChange]) -> list[StatementChange]:
     return flagged
 
 
+def same_statements(pre: Sequence[Statement], post: Sequence[Statement]) -> bool:
+    """Whether two sequences are known equal without reading them: one object (the cache
+    hands both revisions one for an unchanged blob) or equal digests kept by the cache."""
+    if pre is post:
+        return True
+    digest = kept_digest(pre)
+    return digest is not None and digest == kept_digest(post)
+
+
 def diff_statements(
     pre: Sequence[Statement],
     post: Sequence[Statement],
@@ -119,10 +128,7 @@ def diff_statements(
     post_path: str | None = None,
 ) -> FileChange:
     """Γ_A, Γ_R, Γ_M between two statement sequences of one file, with per-statement detail."""
-    if pre is post:  # the cache hands both revisions one object for an unchanged blob
-        return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
-    digest = kept_digest(pre)
-    if digest is not None and digest == kept_digest(post):  # as below, without decoding them
+    if same_statements(pre, post):
         return FileChange(pre_path, post_path, added=0, removed=0, modified=0)
     pre_keys, post_keys = [_key(s) for s in pre], [_key(s) for s in post]
     if pre_keys == post_keys:  # nothing changed but layout or comments
@@ -160,3 +166,80 @@ def diff_files(pre: FileFacts | None, post: FileFacts | None) -> FileChange:
         pre.path if pre else None,
         post.path if post else None,
     )
+
+
+# A file pair's change as a record of JSON types, kept in the cache by the two files' blobs
+# (app/diff.py) so that a diff seen before reads neither file's statements again:
+# [added, removed, modified, approximate, [[action, pre, post, moved], ...]], a statement
+# [kind, start, end, text, function].
+CHANGE_RECORD = "file-change/1"
+
+
+def _statement_record(statement: Statement | None) -> list[object] | None:
+    if statement is None:
+        return None
+    kind, (start, end), text, function = statement
+    return [kind, start, end, text, function]
+
+
+def change_record(change: FileChange) -> list[object]:
+    """``change`` without its paths, as JSON types (:func:`change_from_record` reads it)."""
+    return [
+        change.added,
+        change.removed,
+        change.modified,
+        change.approximate,
+        [
+            [c.action.value, _statement_record(c.pre), _statement_record(c.post), c.moved]
+            for c in change.changes
+        ],
+    ]
+
+
+def _statement_from(record: object) -> Statement | None:
+    if record is None:
+        return None
+    if not (isinstance(record, list) and len(record) == 5):
+        raise ValueError("a statement record has five fields")
+    kind, start, end, text, function = record
+    if not (
+        isinstance(kind, str)
+        and isinstance(text, str)
+        and (function is None or isinstance(function, str))
+        and type(start) is int
+        and type(end) is int
+    ):
+        raise ValueError("a statement record's fields have the wrong types")
+    return Statement(kind, Span(start, end), text, function)  # Span checks the range
+
+
+def change_from_record(
+    record: object, pre_path: str | None, post_path: str | None
+) -> FileChange | None:
+    """The change ``change_record`` made, with these paths; None if ``record`` is anything
+    else (it comes from the cache file, which is not trusted: a bad record is recomputed,
+    never believed), including counts that do not match its changes."""
+    if not (isinstance(record, list) and len(record) == 5):
+        return None
+    added, removed, modified, approximate, rows = record
+    try:
+        changes = []
+        for action, pre, post, moved in rows:
+            change = StatementChange(
+                Action(action), _statement_from(pre), _statement_from(post), moved is True
+            )
+            action = change.action
+            has_pre, has_post = action is not Action.ADDED, action is not Action.REMOVED
+            if (change.pre is not None) != has_pre or (change.post is not None) != has_post:
+                return None
+            changes.append(change)
+    except (TypeError, ValueError):
+        return None
+    count = Counter(c.action for c in changes)
+    counts = (count[Action.ADDED], count[Action.REMOVED], count[Action.MODIFIED])
+    numbers = (added, removed, modified)
+    if any(type(n) is not int for n in numbers) or numbers != counts:
+        return None
+    if type(approximate) is not bool:
+        return None
+    return FileChange(pre_path, post_path, added, removed, modified, tuple(changes), approximate)

@@ -36,8 +36,19 @@ def _diff(repo: GitRepo, tmp_path: Path, *extra: str) -> bytes:
 
 
 def _totals(cache: Path) -> list[tuple[str, bytes]]:
+    """The trees' coupling kept in the cache (file pairs' changes are kept beside it)."""
     with sqlite3.connect(cache) as db:
-        return db.execute("select key, data from totals order by key").fetchall()
+        return db.execute(
+            "select key, data from totals where key not like 'file-change/%' order by key"
+        ).fetchall()
+
+
+def _changes(cache: Path) -> list[tuple[str, bytes]]:
+    """The file pairs' changes kept in the cache."""
+    with sqlite3.connect(cache) as db:
+        return db.execute(
+            "select key, data from totals where key like 'file-change/%' order by key"
+        ).fetchall()
 
 
 def test_each_trees_coupling_is_kept_and_served_byte_for_byte(
@@ -82,7 +93,7 @@ def test_a_kept_total_that_is_not_what_was_computed_is_recomputed(
     plain = _diff(history, tmp_path, "--no-cache")
     _diff(history, tmp_path, "--cache-path", str(cache))
     with sqlite3.connect(cache) as db:
-        db.execute("update totals set data = ?", (stored,))
+        db.execute("update totals set data = ? where key not like 'file-change/%'", (stored,))
     served = _diff(history, tmp_path, "--cache-path", str(cache))
     if stored.startswith(b'{"src/client.py":[9'):
         assert served != plain
@@ -103,3 +114,78 @@ def test_a_cache_made_before_the_totals_table_keeps_its_facts(
     with sqlite3.connect(cache) as db:
         assert db.execute("select count(*) from facts").fetchone()[0] == facts
     assert len(_totals(cache)) == 2
+
+
+def test_each_file_pairs_change_is_kept_and_served_byte_for_byte(
+    history: GitRepo, tmp_path: Path
+) -> None:
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(history, tmp_path, "--no-cache")
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain
+    kept = _changes(cache)
+    assert len(kept) == 2  # shared.py changed, server.py added; client.py is the same blob
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain
+    assert _changes(cache) == kept
+    # what is served is the kept record: rewritten (still well formed), the report follows it
+    with sqlite3.connect(cache) as db:
+        for key, data in kept:
+            record = json.loads(data)
+            if record[0]:  # the added file's record: one statement more, counted
+                record[0] += 1
+                record[4].append(["added", None, ["assignment", 1, 1, "x = 1", None], False])
+                db.execute(
+                    "update totals set data = ? where key = ?", (json.dumps(record).encode(), key)
+                )
+    served = json.loads(_diff(history, tmp_path, "--cache-path", str(cache)))
+    before = json.loads(plain)["locations"]["base"]
+    assert served["locations"]["base"]["added"] == before["added"] + 2  # two records
+
+
+@pytest.mark.parametrize(
+    "stored",
+    [
+        b"not json",
+        b"[]",
+        b'{"a": 1}',
+        b"[1, 0, 0, false, []]",  # a count its changes do not make
+        b'[1, 0, 0, false, [["added", null, ["k", 2, 1, "t", null], false]]]',  # a bad span
+        b'[1, 0, 0, false, [["added", ["k", 1, 1, "t", null], null, false]]]',  # sides swapped
+        b'[1, 0, 0, false, [["grown", null, ["k", 1, 1, "t", null], false]]]',
+        b'[1.0, 0, 0, false, [["added", null, ["k", 1, 1, "t", null], false]]]',
+        b'[1, 0, 0, 0, [["added", null, ["k", 1, 1, "t", null], false]]]',
+        b'[1, 0, 0, false, [["added", null, ["k", 1, 1, 5, null], false]]]',
+    ],
+)
+def test_a_kept_change_that_is_not_what_was_computed_is_recomputed(
+    history: GitRepo, tmp_path: Path, stored: bytes
+) -> None:
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(history, tmp_path, "--no-cache")
+    _diff(history, tmp_path, "--cache-path", str(cache))
+    with sqlite3.connect(cache) as db:
+        db.execute("update totals set data = ? where key like 'file-change/%'", (stored,))
+    assert _diff(history, tmp_path, "--cache-path", str(cache)) == plain
+
+
+def test_diffs_along_a_history_served_from_kept_changes_equal_full_recomputation(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    # a file rewritten over three commits, another renamed, one removed: every pair of
+    # revisions, diffed warm after a cold pass, gives the JSON a diff without a cache gives
+    body = "def f(a):\n    if a:\n        return 1\n    return 2\n"
+    repo.commit("r1", tag="r1", files={"m.py": body, "old.py": SHARED, "gone.py": SERVER})
+    repo.remove("gone.py")
+    repo.commit("r2", tag="r2", files={"m.py": body.replace("1", "10")})
+    repo.git("mv", "old.py", "new.py")
+    repo.commit("r3", tag="r3", files={"m.py": body + "\ndef g():\n    return f(1)\n"})
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+    pairs = [("r1", "r2"), ("r2", "r3"), ("r1", "r3"), ("r3", "r1")]
+    for warm in (False, True):
+        for base, head in pairs:
+            out = tmp_path / "out.json"
+            command = ["diff", "-C", str(repo.root), "--base", base, "--head", head, "-q"]
+            assert main([*command, "--format", "json", *cache, "-o", str(out)]) == 0
+            cached = out.read_bytes()
+            assert main([*command, "--format", "json", "--no-cache", "-o", str(out)]) == 0
+            assert cached == out.read_bytes(), (base, head, warm)
+    assert len(_changes(tmp_path / "cache.sqlite3")) >= 4

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -211,3 +213,25 @@ def test_the_table_in_numpy_is_the_rule(
     assert [(i, j) for i, j, _ in pairing.pair_exact(removed, added)] == _reference_pairs(
         removed, added
     )
+
+
+@given(_SEQ, _SEQ, st.booleans())
+def test_a_change_record_gives_back_the_change(
+    pre_items: list[tuple[str, str]], post_items: list[tuple[str, str]], in_function: bool
+) -> None:
+    # the record the cache keeps (through JSON, as it is stored) makes the same change
+    function = "pkg.f" if in_function else None
+    pre = tuple(s._replace(function=function) for s in stmts(*pre_items))
+    post = stmts(*post_items)
+    change = diff_statements(pre, post, "a.py", "b.py")
+    record = json.loads(json.dumps(statement_diff.change_record(change)))
+    assert statement_diff.change_from_record(record, "a.py", "b.py") == change
+
+
+def test_a_change_record_that_does_not_add_up_is_refused() -> None:
+    change = diff_statements(stmts(A, B), stmts(A, C, B))
+    record = statement_diff.change_record(change)
+    assert statement_diff.change_from_record(record, None, None) is not None
+    assert statement_diff.change_from_record([0, *record[1:]], None, None) is None
+    assert statement_diff.change_from_record([*record[:4], []], None, None) is None
+    assert statement_diff.change_from_record(record[:4], None, None) is None
