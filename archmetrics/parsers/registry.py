@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import metadata
-from pathlib import PurePosixPath
 
 from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import text
@@ -98,6 +97,11 @@ class LanguageTable:
 
     extensions: tuple[tuple[str, str], ...]
     languages: tuple[LanguageSpec, ...]
+    _by_ending: dict[str, str] = field(init=False, repr=False, compare=False, hash=False)
+
+    def __post_init__(self) -> None:
+        by_ending = dict(reversed(self.extensions))  # the first of an ending listed twice
+        object.__setattr__(self, "_by_ending", by_ending)
 
     @classmethod
     def default(
@@ -120,12 +124,14 @@ class LanguageTable:
         return cls(tuple(sorted(extensions.items())), tuple(languages.values()))
 
     def language_of(self, path: str) -> str | None:
-        """The language of ``path`` by its ending, or None when it is not source we measure."""
-        suffix = PurePosixPath(path).suffix.lower()
-        for ending, language in self.extensions:
-            if ending == suffix:
-                return language
-        return None
+        """The language of ``path`` by its ending, or None when it is not source we measure.
+        The ending is what ``PurePosixPath(path).suffix`` gives (none for ``.bashrc`` or
+        ``a.``), found without building a path: a diff asks for every file of two trees."""
+        name = path.rstrip("/").rpartition("/")[2]
+        dot = name.rfind(".")
+        if dot <= 0 or dot == len(name) - 1:
+            return None
+        return self._by_ending.get(name[dot:].lower())
 
     def spec(self, language: str) -> LanguageSpec:
         for spec in self.languages:
