@@ -100,11 +100,14 @@ def parse_all(
         if answer.encoded is None:  # over a limit: reported, never cached (it may pass later)
             results[entry.index] = not_measured(path, language, answer.failure or "unknown")
             return
-        facts = codec.decode(answer.encoded, path)
-        results[entry.index] = facts
-        if cache is not None and answer.cacheable:  # stored as each file arrives
+        if cache is not None and answer.cacheable:  # stored as each file arrives, and
+            # its statements and call sites read back from there when first used
             cache.put_encoded([(entry.blob, language, answer.encoded)])
+            facts = codec.decode(answer.encoded, path, cache.reader(entry.blob, language))
             cache.remember(entry.blob, facts)
+        else:
+            facts = codec.decode(answer.encoded, path)
+        results[entry.index] = facts
 
     workers = worker_count(jobs)
     size = batch_size(len(todo), workers)

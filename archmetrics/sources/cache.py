@@ -21,6 +21,7 @@ import hashlib
 import os
 import sqlite3
 import sys
+import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cache
@@ -99,6 +100,14 @@ class CacheInfo:
     current_entries: int  # entries written by this version of the parsers
 
 
+_RECORD = "select data from facts where blob=? and language=? and parser=?"
+
+
+def _read_only(path: Path) -> sqlite3.Connection:
+    """A connection that can only read the cache at ``path``."""
+    return sqlite3.connect(f"{path.as_uri()}?mode=ro", uri=True, check_same_thread=False)
+
+
 class FactsCache:
     """A SQLite store of facts. Use as a context manager; writes are committed on close."""
 
@@ -119,6 +128,8 @@ class FactsCache:
         # diff's memory); bounded so a long series of revisions does not hold every version.
         self._decoded: dict[tuple[str, str], FileFacts] = {}
         self._db = open_database(self.path, self.notices)
+        self._closed = False
+        self._reader: sqlite3.Connection | None = None
 
     def _run(self, query: Callable[[sqlite3.Connection], _T]) -> _T:
         """``query`` on the database; if SQLite finds the file damaged (a bad page deep in
@@ -139,16 +150,12 @@ class FactsCache:
             self.hits += 1
             return known
         key = (blob, language, self.fingerprint)
-        row = self._run(
-            lambda db: db.execute(
-                "select data from facts where blob=? and language=? and parser=?", key
-            ).fetchone()
-        )
+        row = self._run(lambda db: db.execute(_RECORD, key).fetchone())
         if row is None:
             self.misses += 1
             return None
         try:
-            facts = codec.decode(row[0], path)
+            facts = codec.decode(row[0], path, self.reader(blob, language))
         except codec.CodecError:
             self._run(
                 lambda db: db.execute(
@@ -160,6 +167,33 @@ class FactsCache:
         self.hits += 1
         self.remember(blob, facts)
         return facts
+
+    def reader(self, blob: str, language: str) -> codec.Again:
+        """A function that reads the record kept for ``blob`` and ``language`` (None if there
+        is none now), also after the cache was closed: facts decoded from the cache read
+        their statements and call sites back from it on first use instead of holding them
+        (docs/performance.md, session 10)."""
+        key = (blob, language, self.fingerprint)
+        # a weak reference: facts the cache remembers must not hold the cache (a cycle
+        # through every decoded fact would be left to the garbage collector)
+        cache, path = weakref.ref(self), self.path
+
+        def read() -> bytes | None:
+            live = cache()
+            if live is not None and not live._closed:
+                row = live._run(lambda db: db.execute(_RECORD, key).fetchone())
+            else:
+                db = live._read_only() if live is not None else _read_only(path)
+                row = db.execute(_RECORD, key).fetchone()
+            return bytes(row[0]) if row is not None and isinstance(row[0], bytes) else None
+
+        return read
+
+    def _read_only(self) -> sqlite3.Connection:
+        """A read-only connection to the closed cache, opened once, for ``reader``."""
+        if self._reader is None:
+            self._reader = _read_only(self.path)
+        return self._reader
 
     def remember(self, blob: str, facts: FileFacts) -> None:
         """Keep ``facts`` (just parsed or decoded) for this run: a later ``get`` of the same
@@ -219,6 +253,7 @@ class FactsCache:
             self._run(lambda db: db.commit())
         finally:
             self._db.close()
+            self._closed = True
 
     def __enter__(self) -> FactsCache:
         return self

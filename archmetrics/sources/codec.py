@@ -101,6 +101,11 @@ class _Spans(dict[tuple[int, int], Span]):
         return made
 
 
+# Where a record can be read again (the facts cache's row), a function that reads it: then
+# the records are not kept as bytes until first read but read again then (most never are)
+Again = Callable[[], bytes | None]
+
+
 def _deferred(
     data: bytes,
     count: Any,
@@ -110,14 +115,20 @@ def _deferred(
     make: Callable[[Any], list[Any]],
     keys: frozenset[str] | None = None,
     digest: str | None = None,
+    again: tuple[Again, int] | None = None,
 ) -> Deferred[Any]:
-    """Records left as bytes until first read; their count and checksum are checked now."""
+    """Records left as bytes until first read; their count and checksum are checked now.
+    ``again``: the record's reader and the line these records are on; the bytes are then
+    dropped and read back on first use, checked against the same checksum."""
     if type(count) is not int or zlib.crc32(data) != checksum:
         raise CodecError(f"the {what} do not match their checksum")
+    payload: Callable[[], bytes] = (
+        (lambda: data) if again is None else _reread(again, checksum, what, path)
+    )
 
     def made() -> tuple[Any, ...]:
         try:
-            records = make(json.loads(data))
+            records = make(json.loads(payload()))
         except (ValueError, TypeError) as error:
             raise CodecError(f"bad {what} in the cached facts of {path}: {error}") from error
         if len(records) != count:
@@ -125,6 +136,23 @@ def _deferred(
         return tuple(records)
 
     return Deferred(count, made, keys, digest)
+
+
+def _reread(again: tuple[Again, int], checksum: int, what: str, path: str) -> Callable[[], bytes]:
+    """A reader of one line of a record, which must be the line that was checked."""
+    read, line = again
+
+    def payload() -> bytes:
+        record = read()
+        lines = record.split(b"\n", 2) if record is not None else []
+        if len(lines) != 3 or zlib.crc32(lines[line]) != checksum:
+            raise CodecError(
+                f"the {what} of {path} are no longer in the facts cache as they were when"
+                " read (was it cleared or changed meanwhile?); run the command again"
+            )
+        return lines[line]
+
+    return payload
 
 
 # The records are named tuples, built by tuple's own constructor (their fields are unpacked
@@ -169,7 +197,9 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
     ]
 
 
-def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFacts:
+def _decode(
+    document: Any, calls: bytes, statements: bytes, path: str, again: Again | None
+) -> FileFacts:
     (
         fmt,
         language,
@@ -197,6 +227,7 @@ def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFa
             path,
             _statements,
             digest=digest if isinstance(digest, str) else None,
+            again=None if again is None else (again, 2),
         ),
         functions=tuple(
             [
@@ -228,6 +259,7 @@ def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFa
             path,
             _calls,
             frozenset(intern(callee) for callee in callees),
+            again=None if again is None else (again, 1),
         ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
@@ -236,13 +268,15 @@ def _decode(document: Any, calls: bytes, statements: bytes, path: str) -> FileFa
     )
 
 
-def decode(data: bytes, path: str) -> FileFacts:
-    """The facts ``encode`` wrote, now at ``path``; CodecError for anything else."""
+def decode(data: bytes, path: str, again: Again | None = None) -> FileFacts:
+    """The facts ``encode`` wrote, now at ``path``; CodecError for anything else. ``again``:
+    reads ``data`` again (from the facts cache), so that the statements and call sites are
+    not held as bytes until first read (their checksums are checked now and then)."""
     lines = data.split(b"\n", 2)
     if len(lines) != 3:
         raise CodecError("not a facts record: not three lines")
     try:
-        return _decode(json.loads(lines[0]), lines[1], lines[2], path)
+        return _decode(json.loads(lines[0]), lines[1], lines[2], path, again)
     except CodecError:
         raise
     except (ValueError, TypeError, KeyError) as error:

@@ -4,15 +4,20 @@ serves what it has seen by content, whatever the path."""
 from __future__ import annotations
 
 import json
+import sqlite3
 from pathlib import Path
+
+import pytest
 
 from archmetrics.app.collect import parse_all, select
 from archmetrics.app.workers import FORK_BELOW as PARALLEL_THRESHOLD
 from archmetrics.cli import main
 from archmetrics.parsers import LanguageTable
+from archmetrics.sources import codec
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import DirectorySnapshot
 from tests.gitrepo import GitRepo
+from tests.harness import facts_of
 
 PY = "def f{i}(a):\n    if a > {i}:\n        return [x for x in a if x]\n    return None\n"
 CLIENT = (
@@ -120,3 +125,21 @@ def test_a_diff_is_the_same_without_cache_cold_and_warm(repo: GitRepo, tmp_path:
     assert client["post"]["d_e"] == 1  # the link is there to be found
     assert run(*cache) == plain  # cold
     assert run(*cache) == plain  # warm
+
+
+def test_facts_parsed_in_a_run_read_their_statements_back_from_the_cache(
+    tmp_path: Path,
+) -> None:
+    # a cold run keeps no statement bytes either: what the workers sent is in the cache
+    repo_file = tmp_path / "src" / "m.py"
+    repo_file.parent.mkdir()
+    repo_file.write_text("def f(a):\n    if a:\n        return 1\n    return 2\n")
+    path = tmp_path / "cache.sqlite3"
+    snapshot = DirectorySnapshot(tmp_path / "src")
+    with FactsCache(path) as cache:
+        (facts,) = parse_all(snapshot, select(snapshot, LanguageTable.default()), cache=cache)
+    with sqlite3.connect(path) as db:  # rewritten once the run has closed the cache
+        db.execute("update facts set data = ?", (codec.encode(facts_of("x = 1\n", "python")),))
+    with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
+        facts.statements.items()
+    assert facts.functions[0].complexity == 2  # what was decoded stays

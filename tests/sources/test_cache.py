@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import gc
 import json
 import sqlite3
 import time
@@ -357,3 +359,40 @@ def test_the_fingerprint_names_the_python_that_parsed(monkeypatch: pytest.Monkey
     assert cache_module.parser_fingerprint.__wrapped__() == ours
     monkeypatch.setattr(cache_module.sys, "version", "3.99.0 (another)")
     assert cache_module.parser_fingerprint.__wrapped__() != ours
+
+
+def test_facts_from_the_cache_read_their_statements_back_from_it(tmp_path: Path) -> None:
+    # the statements and call sites are not held as bytes until first read: they are read
+    # again from the cache (also after it was closed), checked against the checksum seen
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE), ("def", SAMPLE)])
+    with FactsCache(path) as cache:
+        first = cache.get("abc", "python", "a/b.py")
+        later = cache.get("def", "python", "a/b.py")
+        assert first is not None and later is not None
+        assert first.statements == SAMPLE.statements  # read while open
+    assert later.statements == SAMPLE.statements  # read after the cache was closed
+    assert later.call_sites == SAMPLE.call_sites
+    with FactsCache(path) as cache:
+        changed = cache.get("abc", "python", "a/b.py")
+        assert changed is not None
+        other = dataclasses.replace(SAMPLE, statements=SAMPLE.statements[:1])
+        with sqlite3.connect(path) as db:  # another process rewrites the entry meanwhile
+            db.execute("update facts set data = ? where blob = 'abc'", (codec.encode(other),))
+        with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
+            changed.statements.items()
+        assert changed.functions == SAMPLE.functions  # what was decoded stays
+
+
+def test_facts_that_outlive_their_cache_object_still_read_back(tmp_path: Path) -> None:
+    # facts hold their cache weakly (no cycle through every decoded fact): once it is gone,
+    # the record is read through a connection of its own, read-only
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+    with FactsCache(path) as cache:
+        facts = cache.get("abc", "python", "a/b.py")
+    del cache
+    gc.collect()
+    assert facts is not None and facts.statements == SAMPLE.statements
