@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 from collections.abc import Mapping, Sequence
@@ -32,7 +33,10 @@ from archmetrics.reports.model import DiffReport
 from archmetrics.sources import Snapshot, git, open_snapshot
 from archmetrics.sources.cache import FactsCache, code_fingerprint
 
-_RAPIDFUZZ = metadata.version("rapidfuzz")
+
+@functools.cache
+def _rapidfuzz() -> str:
+    return metadata.version("rapidfuzz")
 
 
 @dataclass(frozen=True, slots=True)
@@ -165,8 +169,8 @@ def cached_differ(
                     return known
         change = diff_files(pre, post)
         if key is not None:
-            record = json.dumps(change_record(change), separators=(",", ":"), ensure_ascii=False)
-            cache.put_total(key, record.encode("utf-8", "surrogatepass"))
+            # ASCII escapes: a text may hold a lone surrogate, which no UTF-8 can
+            cache.put_total(key, json.dumps(change_record(change), separators=(",", ":")).encode())
         return change
 
     return diff
@@ -192,7 +196,7 @@ def change_key(
         if not blob:
             return None
         sides.append([blob, facts.language])
-    document = [CHANGE_RECORD, code_fingerprint(), _RAPIDFUZZ, parser, sides]
+    document = [CHANGE_RECORD, code_fingerprint(), _rapidfuzz(), parser, sides]
     return f"{CHANGE_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
 
 

@@ -189,3 +189,16 @@ def test_diffs_along_a_history_served_from_kept_changes_equal_full_recomputation
             assert main([*command, "--format", "json", "--no-cache", "-o", str(out)]) == 0
             assert cached == out.read_bytes(), (base, head, warm)
     assert len(_changes(tmp_path / "cache.sqlite3")) >= 4
+
+
+def test_a_change_of_non_ascii_text_is_kept_and_served(repo: GitRepo, tmp_path: Path) -> None:
+    # records are ASCII (JSON escapes): a text may hold any character, a lone surrogate too
+    # (which no UTF-8 can); here a Latin-1 byte of a C string literal, read as U+00E9
+    repo.commit("one", tag="v1", files={"m.c": b'const char *s = "cafe";\n'})
+    repo.commit("two", tag="v2", files={"m.c": b'const char *s = "caf\xe9";\nint n = 1;\n'})
+    cache = tmp_path / "cache.sqlite3"
+    plain = _diff(repo, tmp_path, "--no-cache")
+    assert _diff(repo, tmp_path, "--cache-path", str(cache)) == plain
+    ((_, data),) = _changes(cache)
+    assert b"caf\\u00e9" in data
+    assert _diff(repo, tmp_path, "--cache-path", str(cache)) == plain

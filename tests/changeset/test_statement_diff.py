@@ -235,3 +235,9 @@ def test_a_change_record_that_does_not_add_up_is_refused() -> None:
     assert statement_diff.change_from_record([0, *record[1:]], None, None) is None
     assert statement_diff.change_from_record([*record[:4], []], None, None) is None
     assert statement_diff.change_from_record(record[:4], None, None) is None
+
+
+def test_a_change_record_keeps_a_lone_surrogate_through_ascii_json() -> None:
+    change = diff_statements(stmts(A), stmts(("assign", 'x = "\ud800"')))
+    stored = json.dumps(statement_diff.change_record(change)).encode()  # as the cache keeps it
+    assert statement_diff.change_from_record(json.loads(stored), None, None) == change
