@@ -6,7 +6,7 @@ import functools
 import hashlib
 import json
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
 
@@ -236,10 +236,10 @@ def _parse_side(
 ) -> tuple[FileFacts, ...]:
     overrides = request.settings.languages
     selected = select(snapshot, LanguageTable.default(dict(overrides)))
-    jobs, limits = (
-        request.jobs or request.settings.jobs,
-        worker_limits(request.settings.limits, request.settings.macros),
-    )
+    limits = worker_limits(request.settings.limits, request.settings.macros)
+    # generated files count nowhere unless asked for: the first lines that say so suffice
+    limits = replace(limits, skip_generated=not request.settings.include_generated)
+    jobs = request.jobs or request.settings.jobs
     return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits, blobs)
 
 

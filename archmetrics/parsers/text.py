@@ -34,6 +34,12 @@ def declares_generated(source: str) -> bool:
     return any(_GENERATED.search(line) for line in head)
 
 
+def declares_generated_bytes(data: bytes) -> bool:
+    """``declares_generated`` of a file's bytes, reading only its first lines."""
+    head = data.split(b"\n", _HEAD_LINES)[:_HEAD_LINES]
+    return declares_generated(b"\n".join(head).decode("utf-8", "replace"))
+
+
 _COLLAPSE = re.compile(r"\s+")
 
 
