@@ -89,6 +89,8 @@ def parse_all(
         if blobs is not None:
             blobs[item.file.path] = blob
         hit = cache.get(blob, item.language, item.file.path) if cache else None
+        if hit is None and cache and limits.skip_generated and cache.unread(blob, item.language):
+            hit = FileFacts(path=item.file.path, language=item.language, generated=True)
         if hit is None:
             todo.append(_Todo(index, item, blob, data))
         results[index] = hit
@@ -100,6 +102,8 @@ def parse_all(
         if answer.encoded is None:  # over a limit: reported, never cached (it may pass later)
             results[entry.index] = not_measured(path, language, answer.failure or "unknown")
             return
+        if cache is not None and answer.unread:  # known generated: no facts, a mark
+            cache.mark_unread(entry.blob, language)
         if cache is not None and answer.cacheable:  # stored as each file arrives, and
             # its statements and call sites read back from there when first used
             cache.put_encoded([(entry.blob, language, answer.encoded)])

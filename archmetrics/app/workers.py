@@ -66,6 +66,7 @@ class Parsed:
     encoded: bytes | None
     failure: str | None = None
     cacheable: bool = True  # False: the outcome depended on the clock (a parse cut off)
+    unread: bool = False  # True: generated, read no further (``WorkerLimits.skip_generated``)
 
 
 Deliver = Callable[[T, Parsed], None]
@@ -156,7 +157,7 @@ def _parse_one(
     started = time.monotonic()
     if limits.skip_generated and declares_generated_bytes(data):
         unread = FileFacts(path=path, language=language, generated=True)
-        return Parsed(codec.encode(unread), cacheable=False)
+        return Parsed(codec.encode(unread), cacheable=False, unread=True)
     try:
         facts = parse_source(path, data, language, table, limits.parser)
         timed_out = not facts.parsed and time.monotonic() - started >= limits.parser.parse_seconds
