@@ -180,11 +180,14 @@ class FactsCache:
 
         def read() -> bytes | None:
             live = cache()
-            if live is not None and not live._closed:
-                row = live._run(lambda db: db.execute(_RECORD, key).fetchone())
-            else:
-                db = live._read_only() if live is not None else _read_only(path)
-                row = db.execute(_RECORD, key).fetchone()
+            try:
+                if live is not None and not live._closed:
+                    row = live._run(lambda db: db.execute(_RECORD, key).fetchone())
+                else:
+                    db = live._read_only() if live is not None else _read_only(path)
+                    row = db.execute(_RECORD, key).fetchone()
+            except (sqlite3.Error, CacheError):  # gone or unreadable: the caller says so
+                return None
             return bytes(row[0]) if row is not None and isinstance(row[0], bytes) else None
 
         return read

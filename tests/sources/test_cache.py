@@ -396,3 +396,15 @@ def test_facts_that_outlive_their_cache_object_still_read_back(tmp_path: Path) -
     del cache
     gc.collect()
     assert facts is not None and facts.statements == SAMPLE.statements
+
+
+def test_facts_whose_cache_file_is_gone_fail_with_a_codec_error(tmp_path: Path) -> None:
+    path = tmp_path / "cache.sqlite3"
+    with FactsCache(path) as cache:
+        cache.put_many([("abc", SAMPLE)])
+    with FactsCache(path) as cache:
+        facts = cache.get("abc", "python", "a/b.py")
+    path.unlink()
+    assert facts is not None
+    with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
+        facts.call_sites.items()
