@@ -385,26 +385,29 @@ def test_facts_from_the_cache_read_their_statements_back_from_it(tmp_path: Path)
         assert changed.functions == SAMPLE.functions  # what was decoded stays
 
 
-def test_facts_that_outlive_their_cache_object_still_read_back(tmp_path: Path) -> None:
-    # facts hold their cache weakly (no cycle through every decoded fact): once it is gone,
-    # the record is read through a connection of its own, read-only
-    path = tmp_path / "cache.sqlite3"
+def _kept_and_read_back(path: Path) -> FileFacts:
+    """SAMPLE stored in a new cache at ``path``, then decoded from it by another cache
+    object, which is closed and dropped before the facts are returned."""
     with FactsCache(path) as cache:
         cache.put_many([("abc", SAMPLE)])
     with FactsCache(path) as cache:
         facts = cache.get("abc", "python", "a/b.py")
     del cache
     gc.collect()
-    assert facts is not None and facts.statements == SAMPLE.statements
+    assert facts is not None
+    return facts
+
+
+def test_facts_that_outlive_their_cache_object_still_read_back(tmp_path: Path) -> None:
+    # facts hold their cache weakly (no cycle through every decoded fact): once it is gone,
+    # the record is read through a connection of its own, read-only
+    facts = _kept_and_read_back(tmp_path / "cache.sqlite3")
+    assert facts.statements == SAMPLE.statements
 
 
 def test_facts_whose_cache_file_is_gone_fail_with_a_codec_error(tmp_path: Path) -> None:
     path = tmp_path / "cache.sqlite3"
-    with FactsCache(path) as cache:
-        cache.put_many([("abc", SAMPLE)])
-    with FactsCache(path) as cache:
-        facts = cache.get("abc", "python", "a/b.py")
+    facts = _kept_and_read_back(path)
     path.unlink()
-    assert facts is not None
     with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
         facts.call_sites.items()
