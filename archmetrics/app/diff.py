@@ -5,10 +5,11 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
+from typing import TypeVar
 
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
@@ -91,15 +92,46 @@ def coupling_values(
         if cache is None or blobs is None
         else coupling_key(measured, blobs, options, packs, cache.fingerprint)
     )
-    if cache is not None and key is not None:
-        known = _read_coupling(cache.get_total(key))
-        if known is not None:
-            return known
-    report = measure_coupling(measured, options, packs)
-    values = {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
-    if cache is not None and key is not None:
-        cache.put_total(key, json.dumps(values, separators=(",", ":")).encode())
-    return values
+
+    def compute() -> dict[str, Coupling]:
+        report = measure_coupling(measured, options, packs)
+        return {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
+
+    return _kept(cache, key, _read_coupling, compute, _compact)
+
+
+_T = TypeVar("_T")
+
+
+def _kept(
+    cache: FactsCache | None,
+    key: str | None,
+    read: Callable[[bytes], _T | None],
+    compute: Callable[[], _T],
+    write: Callable[[_T], bytes],
+) -> _T:
+    """What ``cache`` keeps under ``key`` if ``read`` believes it (the cache file is not
+    trusted: ``read`` gives None for anything it did not write), else ``compute``'s result,
+    kept as ``write`` gives it. Without a cache or a key, computed."""
+    if cache is None or key is None:
+        return compute()
+    data = cache.get_total(key)
+    known = read(data) if data is not None else None
+    if known is not None:
+        return known
+    value = compute()
+    cache.put_total(key, write(value))
+    return value
+
+
+def _compact(value: object) -> bytes:
+    """JSON without blanks, ASCII escapes (a text may hold a lone surrogate, which no UTF-8
+    can)."""
+    return json.dumps(value, separators=(",", ":")).encode()
+
+
+def _digest(document: Sequence[object]) -> str:
+    return hashlib.sha256(json.dumps(document).encode()).hexdigest()
 
 
 def coupling_key(
@@ -119,15 +151,12 @@ def coupling_key(
         if not blob:
             return None
         files.append((facts.path, blob, facts.language))
-    document = ["coupling/1", code_fingerprint(), parser, repr(options), repr(packs), files]
-    return hashlib.sha256(json.dumps(document).encode()).hexdigest()
+    return _digest(["coupling/1", code_fingerprint(), parser, repr(options), repr(packs), files])
 
 
-def _read_coupling(data: bytes | None) -> dict[str, Coupling] | None:
+def _read_coupling(data: bytes) -> dict[str, Coupling] | None:
     """Coupling values as ``coupling_values`` stored them, or None if ``data`` is anything
     else (the cache file is not trusted: a bad entry is recomputed, never believed)."""
-    if data is None:
-        return None
     try:
         document = json.loads(data)
     except ValueError:
@@ -154,24 +183,24 @@ def cached_differ(
     diff of a branch, a warm rerun, each stage of a series) reads neither file's statements."""
 
     def diff(pre: FileFacts | None, post: FileFacts | None) -> FileChange:
-        pre_path, post_path = pre.path if pre else None, post.path if post else None
         if pre and post and same_statements(pre.statements, post.statements):
             return diff_files(pre, post)  # known equal without reading them: nothing to keep
+        pre_path, post_path = pre.path if pre else None, post.path if post else None
+
+        def read(data: bytes) -> FileChange | None:
+            try:
+                return change_from_record(json.loads(data), pre_path, post_path)
+            except ValueError:
+                return None
+
         key = change_key(pre, post, pre_blobs, post_blobs, cache.fingerprint)
-        if key is not None:
-            data = cache.get_total(key)
-            if data is not None:
-                try:
-                    known = change_from_record(json.loads(data), pre_path, post_path)
-                except ValueError:
-                    known = None
-                if known is not None:
-                    return known
-        change = diff_files(pre, post)
-        if key is not None:
-            # ASCII escapes: a text may hold a lone surrogate, which no UTF-8 can
-            cache.put_total(key, json.dumps(change_record(change), separators=(",", ":")).encode())
-        return change
+        return _kept(
+            cache,
+            key,
+            read,
+            lambda: diff_files(pre, post),
+            lambda change: _compact(change_record(change)),
+        )
 
     return diff
 
@@ -197,7 +226,7 @@ def change_key(
             return None
         sides.append([blob, facts.language])
     document = [CHANGE_RECORD, code_fingerprint(), _rapidfuzz(), parser, sides]
-    return f"{CHANGE_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
+    return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
 def pair_files(
