@@ -197,9 +197,10 @@ def _rules(names: MacroNames) -> tuple[Rule, ...]:
         # in a body too: ASSERT_HEX(unsigned short, 2badU);
         Rule(_at_line_start(rb"[ \t]*+" + macro + rb"(" + _ARGS + rb")"), types=True),
         # EXPECT_EQ(WS WS WS, f(x))   (string macros side by side, no literal among them:
-        # all but the first blanked, the argument stays one expression)
+        # all but the first blanked, the argument stays one expression; a word against a
+        # quote is the literal's prefix, g(MY_R R"(x)"), not a macro)
         Rule(_keywords((rb"\(", b","), rb"\s*+" + macro + rb"((?:\s++" + macro
-                       + rb")++)(?=\s*+[,)\"])")),
+                       + rb")++)(?=\s*+[,)]|\s++\")")),
         # for (; const char* p = next(s); ...)   (a declaration as a `for` condition, which
         # tree-sitter-cpp's grammar lacks: its type blanked, an assignment is left)
         Rule(_keywords((b"for",), rb"\s*+\(\s*+;\s*+((?:const\s++)?[A-Za-z_][\w:]*+(?:\s*+[*&]++"
@@ -241,6 +242,7 @@ _LITERALS = re.compile(
     rb"|//[^\n]*+|/\*(?:[^*]|\*(?!/))*+(?:\*/|\Z)"
 )
 _LITERAL_EDGE = re.compile(rb"[\"'/\\\n]")
+_EDGE_BYTES = frozenset((b'"', b"'", b"/", b"\\"))
 _ENUM_OR_VALUE = re.compile(rb"(?:\benum\b[^;{}]*|=\s*)\{\s*$")
 _CONTINUING = frozenset(b",(=|&+-*/?:<[!~%^")
 
@@ -356,9 +358,14 @@ def blank_macros(
         if wanted is not None and start not in wanted:
             continue
         # blanks inside a comment or a literal change no parse, unless they reach its edge:
-        # only a group holding or touching a quote, a slash, a backslash or a line end is
-        # checked (touching: the `*` of a `/*` or a `*/`)
-        if _LITERAL_EDGE.search(data, max(0, start - 1), end + 1) is not None:
+        # only a group holding a quote, a slash, a backslash or a line end, or touching one
+        # of the first three, is checked (touching: the `*` of a `/*` or a `*/`, the `R` of
+        # a raw string); a line end before or after a group is no edge of what it is in
+        if (
+            _LITERAL_EDGE.search(data, start, end) is not None
+            or data[start - 1 : start] in _EDGE_BYTES
+            or data[end : end + 1] in _EDGE_BYTES
+        ):
             literal = literal_spans(data) if literal is None else literal
             if start in literal:
                 continue

@@ -165,6 +165,23 @@ def test_a_macro_inside_a_string_or_comment_leaves_the_literal_whole() -> None:
     assert str(parser.parse(blanked).root_node) == str(parser.parse(source).root_node)
 
 
+def test_a_macro_at_a_line_start_inside_a_literal_leaves_the_literal_whole() -> None:
+    # a line end before or after a blanked group is no literal's edge: the group at the
+    # start of a line inside a block comment or a raw string is blanked without looking the
+    # literal up, and the literal keeps its extent; a raw string's `R` is an edge
+    source = (
+        b"/*\nNPY_NO_EXPORT int f(void);\n*/\nconst char *r = R\"(\n"
+        b"NPY_NO_EXPORT int g(void);\n)\";\nint h(void);\n"
+    )
+    blanked = blank_macros(source, first=True)
+    assert blanked.count(b"NPY_NO_EXPORT") == 0
+    assert literal_spans(blanked)._spans == literal_spans(source)._spans
+    parser = grammar(Language.CPP).parser
+    assert str(parser.parse(blanked).root_node) == str(parser.parse(source).root_node)
+    raw = b"void f() { g(MY_R R\"(x)\"); }\n"
+    assert literal_spans(blank_macros(raw))._spans == literal_spans(raw)._spans
+
+
 def test_a_macro_run_that_leaves_a_comment_is_left_alone() -> None:
     # the group would run from inside a line comment past its end: blanking it would change
     # the code after the comment
