@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-
-import numpy as np
-from rapidfuzz import process
-from rapidfuzz.distance import Indel
+from typing import TYPE_CHECKING
 
 from archmetrics.facts import Statement
+
+if TYPE_CHECKING:
+    import numpy as np
+
+# numpy and rapidfuzz (60 ms to import) are imported where a run is paired: a scan, a
+# report or `--help` never pairs one (docs/performance.md, "Start-up")
 
 SIMILARITY_THRESHOLD = 0.5
 """Token ratio 2·LCS/T at or above which two statements of different kinds still pair."""
@@ -48,6 +51,8 @@ def tokens(text: str) -> tuple[str, ...]:
 
 def similarity(a: str, b: str) -> float:
     """2·LCS/T over the token sequences of two statement texts (1.0 if both are empty)."""
+    from rapidfuzz.distance import Indel
+
     return float(Indel.normalized_similarity(tokens(a), tokens(b)))
 
 
@@ -68,6 +73,10 @@ def forced(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs | 
 
 
 def _ratios(removed: Sequence[Statement], added: Sequence[Statement]) -> np.ndarray:
+    import numpy as np
+    from rapidfuzz import process
+    from rapidfuzz.distance import Indel
+
     return process.cdist(
         [tokens(r.text) for r in removed],
         [tokens(a.text) for a in added],
@@ -83,6 +92,8 @@ def pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> Pair
     ``best[i, j]`` is the best pairing of the first i removed and j added statements, as one
     integer: pairs x ``scale`` + summed similarity in quanta (``scale`` exceeds any sum, so
     comparing integers compares (pairs, similarity) in that order)."""
+    import numpy as np
+
     m, n = len(removed), len(added)
     ratio = _ratios(removed, added)
     kinds = {kind: number for number, kind in enumerate({s.kind for s in (*removed, *added)})}
@@ -112,6 +123,8 @@ def pair_exact(removed: Sequence[Statement], added: Sequence[Statement]) -> Pair
 
 def pair_greedy(removed: Sequence[Statement], added: Sequence[Statement]) -> Pairs:
     """Fallback for huge runs: each removed statement takes the first partner ahead of the last."""
+    from rapidfuzz.distance import Indel
+
     pairs: Pairs = []
     start = 0
     added_tokens = [tokens(a.text) for a in added]
