@@ -21,7 +21,8 @@ _LIZARD_FILE_LINE = re.compile(r"^\s*\d+\s+\d+\.\d+\s+\d+\.\d+\s+\d+\.\d+\s+\d+\
 
 @dataclass(frozen=True, slots=True)
 class Row:
-    """archmetrics (``ours``) against a peer on the same files; ``goal`` is the speed-up wanted."""
+    """archmetrics (``ours``) against a peer on the same files; ``goal`` is the speed-up wanted
+    (0: none, a row for reference)."""
 
     measure: str
     tree: Tree | None
@@ -138,11 +139,11 @@ def _speed_row(row: Row) -> str:
     files = f"{row.files[0]} / {row.files[1]}" if row.files else "-"
     if row.tree is not None:
         files += f" ({row.tree.bytes / 1e6:.1f} MB)"
-    goal = f"≥ {row.goal:g}x"
+    goal = f"≥ {row.goal:g}x" if row.goal else "(reference)"
     if row.theirs is None:
         return f"| {row.measure} | {files} | {_pair(row.ours)} | {row.peer} | - | {goal} | - |"
     wall, cpu = row.theirs.wall / row.ours.wall, row.theirs.cpu / row.ours.cpu
-    met = "yes" if wall >= row.goal else "**no**"
+    met = "-" if not row.goal else "yes" if wall >= row.goal else "**no**"
     return (
         f"| {row.measure} | {files} | {_pair(row.ours)} | {row.peer}: {_pair(row.theirs)} "
         f"| {wall:.2f}x / {cpu:.2f}x | {goal} | {met} |"
