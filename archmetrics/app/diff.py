@@ -28,6 +28,7 @@ from archmetrics.changeset.statement_diff import (
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, group_elements, measure_coupling
 from archmetrics.coupling.rules import RuleSet
+from archmetrics.coupling.sitememo import RECORD, SiteMemo
 from archmetrics.facts import FileFacts, ParseWarning
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import DiffReport
@@ -94,10 +95,41 @@ def coupling_values(
     )
 
     def compute() -> dict[str, Coupling]:
-        report = measure_coupling(measured, options, packs)
+        memo = None
+        if cache is not None and blobs is not None:
+            memo = site_memo(cache, measured, blobs, options, packs)
+        report = measure_coupling(measured, options, packs, memo)
         return {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
 
     return _kept(cache, key, _read_coupling, compute, _compact)
+
+
+class _CachedSites:
+    """The facts cache as a store of link-site records (coupling/sitememo.py)."""
+
+    def __init__(self, cache: FactsCache) -> None:
+        self.cache = cache
+
+    def get_many(self, keys: Sequence[str]) -> Mapping[str, bytes]:
+        return self.cache.get_totals(keys)
+
+    def put_many(self, items: Mapping[str, bytes]) -> None:
+        self.cache.put_totals(items.items())
+
+
+def site_memo(
+    cache: FactsCache,
+    measured: Sequence[FileFacts],
+    blobs: Mapping[str, str],
+    options: CouplingOptions,
+    packs: RuleSet,
+) -> SiteMemo:
+    """Each file's link sites kept in ``cache`` by content: a tree coupled after another that
+    shares most of its files (the worktree after an edit, the next revision of a series)
+    matches rules and traces endpoints only for the files whose reach changed."""
+    context = _digest([RECORD, code_fingerprint(), cache.fingerprint, repr(options), repr(packs)])
+    identity = {f.path: f"{blobs[f.path]}:{f.language}" for f in measured if blobs.get(f.path)}
+    return SiteMemo(_CachedSites(cache), context, identity)
 
 
 _T = TypeVar("_T")

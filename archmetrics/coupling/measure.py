@@ -20,6 +20,7 @@ from archmetrics.coupling.model import (
     StaticDependency,
 )
 from archmetrics.coupling.rules import Role, RuleSet
+from archmetrics.coupling.sitememo import SiteMemo, decode_sites, encode_sites, site_key
 from archmetrics.coupling.static import (
     Occurrence,
     StaticResolver,
@@ -36,11 +37,13 @@ def measure_coupling(
     files: Sequence[FileFacts],
     options: CouplingOptions | None = None,
     rules: RuleSet | None = None,
+    memo: SiteMemo | None = None,
 ) -> CouplingReport:
     """Static and dynamic coupling of every element of the tree the ``files`` make up.
 
     Paths must be relative to the tree root. ``rules`` come from :func:`load_rule_packs`;
-    without them only static coupling is measured.
+    without them only static coupling is measured. ``memo``: where each file's link sites
+    are kept by content (sitememo.py); the report is the same with or without it.
     """
     options = options or CouplingOptions()
     rules = rules or RuleSet()
@@ -52,9 +55,8 @@ def measure_coupling(
     occurrences = {path: resolver.resolve_file(facts) for path, facts in by_path.items()}
     dependencies = {e.name: element_dependencies(e, occurrences, element_of) for e in elements}
     constants = _Constants(by_path)
-    sites = resolve(
-        {e.name: _element_sites(e, by_path, occurrences, rules, constants) for e in elements}
-    )
+    found = _Sites(by_path, occurrences, rules, constants, memo).of(elements)
+    sites = resolve({e.name: found[e.name] for e in elements})
     afferent = dependents(dependencies)
     incoming = _incoming(sites)
     return CouplingReport(
@@ -99,26 +101,64 @@ def _reachable(path: str, occurrences: Mapping[str, tuple[Occurrence, ...]]) -> 
     return order
 
 
-def _element_sites(
-    element: Element,
-    by_path: Mapping[str, FileFacts],
-    occurrences: Mapping[str, tuple[Occurrence, ...]],
-    rules: RuleSet,
-    constants: _Constants,
-) -> tuple[LinkSite, ...]:
-    found: list[LinkSite] = []
-    for path in element.files:
+class _Sites:
+    """Each element's unresolved link sites, file by file: read back from the memo where a
+    file's key is kept, else found by the rules (and kept)."""
+
+    def __init__(
+        self,
+        by_path: Mapping[str, FileFacts],
+        occurrences: Mapping[str, tuple[Occurrence, ...]],
+        rules: RuleSet,
+        constants: _Constants,
+        memo: SiteMemo | None,
+    ) -> None:
+        self.by_path, self.occurrences = by_path, occurrences
+        self.rules, self.constants, self.memo = rules, constants, memo
+
+    def of(self, elements: Sequence[Element]) -> dict[str, tuple[LinkSite, ...]]:
+        plans = [
+            (e, path, _reachable(path, self.occurrences)) for e in elements for path in e.files
+        ]
+        known: dict[str, tuple[LinkSite, ...]] = {}
+        keys: dict[str, str] = {}
+        if self.memo is not None:
+            for element, path, reachable in plans:
+                bindings = [(o.name, o.target_file) for o in self.occurrences.get(path, ())]
+                key = site_key(self.memo, path, reachable, element.files, bindings)
+                if key is not None:
+                    keys[path] = key
+            stored = self.memo.store.get_many(sorted(set(keys.values())))
+            for path, key in keys.items():
+                data = stored.get(key)
+                read = decode_sites(path, data) if data is not None else None
+                if read is not None:
+                    known[path] = read
+        kept: dict[str, bytes] = {}
+        found: dict[str, list[LinkSite]] = {e.name: [] for e in elements}
+        for element, path, reachable in plans:
+            sites = known.get(path)
+            if sites is None:
+                sites = self._file(element, path, reachable)
+                record = encode_sites(path, sites) if path in keys else None
+                if record is not None:
+                    kept[keys[path]] = record
+            found[element.name].extend(sites)
+        if kept and self.memo is not None:
+            self.memo.store.put_many(kept)
+        return {name: tuple(sites) for name, sites in found.items()}
+
+    def _file(self, element: Element, path: str, reachable: list[str]) -> tuple[LinkSite, ...]:
+        by_path, occurrences = self.by_path, self.occurrences
         facts = by_path[path]
-        reachable = _reachable(path, occurrences)
-        lookup = constants.lookup([p for p in reachable if p in by_path])
+        lookup = self.constants.lookup([p for p in reachable if p in by_path])
         seen = reachable if facts.language in _C_FAMILY else [path]
         visible = {d.target for p in (*seen, *element.files) for d in by_path[p].dependencies}
         submodules = [o.name for o in occurrences.get(path, ()) if o.target_file]
         python = facts.language == Language.PYTHON
         modules = module_bindings(facts.dependencies, submodules) if python else frozenset()
         tracer = Tracer(facts, lookup, modules)
-        found.extend(file_link_sites(facts, rules, sorted(visible), tracer.read, modules))
-    return tuple(found)
+        return file_link_sites(facts, self.rules, sorted(visible), tracer.read, modules)
 
 
 def _incoming(sites: Mapping[str, tuple[LinkSite, ...]]) -> dict[str, list[LinkSite]]:

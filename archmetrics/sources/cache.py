@@ -22,7 +22,7 @@ import os
 import sqlite3
 import sys
 import weakref
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import cache
 from importlib import metadata
@@ -226,6 +226,33 @@ class FactsCache:
         except CacheError:  # no totals table (a read-only cache made before it): not kept
             return None
         return bytes(row[0]) if row is not None and isinstance(row[0], bytes) else None
+
+    def get_totals(self, keys: Sequence[str]) -> dict[str, bytes]:
+        """What was stored under each of ``keys`` that has a row (as untrusted as
+        ``get_total``'s bytes), asked 500 keys a query."""
+        found: dict[str, bytes] = {}
+        for start in range(0, len(keys), 500):
+            chunk = list(keys[start : start + 500])
+
+            def rows(db: sqlite3.Connection, chunk: list[str] = chunk) -> list[tuple[object, ...]]:
+                marks = ",".join("?" * len(chunk))
+                query = f"select key, data from totals where key in ({marks})"
+                return db.execute(query, chunk).fetchall()
+
+            try:
+                for key, data in self._run(rows):
+                    if isinstance(key, str) and isinstance(data, bytes):
+                        found[key] = data
+            except CacheError:  # no totals table (a read-only cache made before it)
+                return {}
+        return found
+
+    def put_totals(self, items: Iterable[tuple[str, bytes]]) -> None:
+        rows = list(items)
+        with contextlib.suppress(CacheError):
+            self._run(
+                lambda db: db.executemany("insert or replace into totals values (?, ?)", rows)
+            )
 
     def put_total(self, key: str, data: bytes) -> None:
         with contextlib.suppress(CacheError):

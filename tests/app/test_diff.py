@@ -40,7 +40,7 @@ def _totals(cache: Path) -> list[tuple[str, bytes]]:
     with sqlite3.connect(cache) as db:
         return db.execute(
             "select key, data from totals where key not like 'file-change/%'"
-            " and key not like 'generated-head/%' order by key"
+            " and key not like 'generated-head/%' and key not like 'link-sites/%' order by key"
         ).fetchall()
 
 
@@ -94,7 +94,11 @@ def test_a_kept_total_that_is_not_what_was_computed_is_recomputed(
     plain = _diff(history, tmp_path, "--no-cache")
     _diff(history, tmp_path, "--cache-path", str(cache))
     with sqlite3.connect(cache) as db:
-        db.execute("update totals set data = ? where key not like 'file-change/%'", (stored,))
+        db.execute(
+            "update totals set data = ? where key not like 'file-change/%'"
+            " and key not like 'link-sites/%'",
+            (stored,),
+        )
     served = _diff(history, tmp_path, "--cache-path", str(cache))
     if stored.startswith(b'{"src/client.py":[9'):
         assert served != plain
@@ -232,3 +236,34 @@ def test_a_generated_file_is_read_no_further_than_its_first_lines(
     assert [w for w in counted["warnings"] if "gen.c" in json.dumps(w)]
     gen = next(e for e in counted["elements"] if e["element"] == "gen")
     assert gen["post"]["vg"] >= 1
+
+
+def test_an_edited_worktree_finds_the_link_sites_of_the_edited_files_only(
+    history: GitRepo, tmp_path: Path
+) -> None:
+    # each file's link sites are kept by content (coupling/sitememo.py): after an edit, the
+    # worktree's coupling reads back every file whose reach did not change, and the JSON is
+    # the JSON of a diff without a cache
+    history.git("checkout", "-q", "v2")
+    cache = tmp_path / "cache.sqlite3"
+    out = tmp_path / "out.json"
+    command = ["diff", "-C", str(history.root), "--base", "HEAD", "--head", "WORKTREE", "-q"]
+    command += ["--format", "json", "-o", str(out)]
+    assert main([*command, "--cache-path", str(cache)]) == 0
+
+    def sites() -> set[str]:
+        with sqlite3.connect(cache) as db:
+            rows = db.execute("select key from totals where key like 'link-sites/%'")
+            return {key for (key,) in rows}
+
+    before = sites()
+    assert len(before) == 3  # client, server, shared: the same in both trees
+    server = history.root / "src/server.py"
+    server.write_text(SERVER.replace("5555", "6666"))
+    assert main([*command, "--cache-path", str(cache)]) == 0
+    cached = out.read_bytes()
+    assert main([*command, "--no-cache"]) == 0
+    assert cached == out.read_bytes()
+    post = {e["element"]: e["post"] for e in json.loads(cached)["elements"]}
+    assert post["src/server.py"]["d_a"] == 0  # the client still connects to 5555
+    assert len(sites() - before) == 1  # the edited server's; the others were read back
