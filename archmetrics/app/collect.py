@@ -107,7 +107,8 @@ def parse_all(
         if cache is not None and answer.cacheable:  # stored as each file arrives, and
             # its statements and call sites read back from there when first used
             cache.put_encoded([(entry.blob, language, answer.encoded)])
-            facts = codec.decode(answer.encoded, path, cache.reader(entry.blob, language))
+            again = cache.reader(entry.blob, language)
+            facts = codec.decode(answer.encoded, path, again, cache.forgetter(entry.blob, language))
             cache.remember(entry.blob, facts)
         else:
             facts = codec.decode(answer.encoded, path)

@@ -100,7 +100,15 @@ class CacheInfo:
     current_entries: int  # entries written by this version of the parsers
 
 
-_RECORD = "select data from facts where blob=? and language=? and parser=?"
+# a record's head, and whether its body is there (a record is written in one transaction,
+# so both are or neither; a cache that lost one is not believed)
+_HEAD = (
+    "select f.data, b.blob is not null from facts f left join bodies b"
+    " on b.blob=f.blob and b.language=f.language and b.parser=f.parser"
+    " where f.blob=? and f.language=? and f.parser=?"
+)
+_BODY = "select data from bodies where blob=? and language=? and parser=?"
+_KEY = "blob=? and language=? and parser=?"
 
 
 def _read_only(path: Path) -> sqlite3.Connection:
@@ -128,6 +136,15 @@ class FactsCache:
         # diff's memory); bounded so a long series of revisions does not hold every version.
         self._decoded: dict[tuple[str, str], FileFacts] = {}
         self._db = open_database(self.path, self.notices)
+        # a read-only cache made before the bodies table holds no facts of this version
+        self._bodies = self._run(
+            lambda db: (
+                db.execute(
+                    "select count(*) from sqlite_master where type='table' and name='bodies'"
+                ).fetchone()[0]
+                == 1
+            )
+        )
         self._closed = False
         self._reader: sqlite3.Connection | None = None
 
@@ -150,29 +167,48 @@ class FactsCache:
             self.hits += 1
             return known
         key = (blob, language, self.fingerprint)
-        row = self._run(lambda db: db.execute(_RECORD, key).fetchone())
+        row = self._run(lambda db: db.execute(_HEAD, key).fetchone()) if self._bodies else None
         if row is None:
             self.misses += 1
             return None
         try:
-            facts = codec.decode(row[0], path, self.reader(blob, language))
-        except codec.CodecError:
-            self._run(
-                lambda db: db.execute(
-                    "delete from facts where blob=? and language=? and parser=?", key
-                )
+            if not (isinstance(row[0], bytes) and row[1]):
+                raise codec.CodecError("a record without its body")
+            facts = codec.decode_head(
+                row[0], path, self.reader(blob, language), self.forgetter(blob, language)
             )
+        except codec.CodecError:
+            self._forget(key)
             self.misses += 1
             return None
         self.hits += 1
         self.remember(blob, facts)
         return facts
 
+    def _forget(self, key: tuple[str, str, str]) -> None:
+        self._run(lambda db: db.execute(f"delete from facts where {_KEY}", key))
+        self._run(lambda db: db.execute(f"delete from bodies where {_KEY}", key))
+
+    def forgetter(self, blob: str, language: str) -> codec.Forget:
+        """A function that drops the record kept for ``blob`` and ``language`` (when its body
+        is not what its head says), if the cache is still open."""
+        key = (blob, language, self.fingerprint)
+        cache = weakref.ref(self)
+
+        def forget() -> None:
+            live = cache()
+            if live is not None and not live._closed:
+                with contextlib.suppress(CacheError, sqlite3.Error):
+                    live._decoded.pop((blob, language), None)
+                    live._forget(key)
+
+        return forget
+
     def reader(self, blob: str, language: str) -> codec.Again:
-        """A function that reads the record kept for ``blob`` and ``language`` (None if there
-        is none now), also after the cache was closed: facts decoded from the cache read
-        their statements and call sites back from it on first use instead of holding them
-        (docs/performance.md, session 10)."""
+        """A function that reads the body of the record kept for ``blob`` and ``language``
+        (None if there is none now), also after the cache was closed: facts decoded from the
+        cache read their statements and call sites back from it on first use instead of
+        holding them (docs/performance.md, session 10)."""
         key = (blob, language, self.fingerprint)
         # a weak reference: facts the cache remembers must not hold the cache (a cycle
         # through every decoded fact would be left to the garbage collector)
@@ -182,10 +218,10 @@ class FactsCache:
             live = cache()
             try:
                 if live is not None and not live._closed:
-                    row = live._run(lambda db: db.execute(_RECORD, key).fetchone())
+                    row = live._run(lambda db: db.execute(_BODY, key).fetchone())
                 else:
                     db = live._read_only() if live is not None else _read_only(path)
-                    row = db.execute(_RECORD, key).fetchone()
+                    row = db.execute(_BODY, key).fetchone()
             except (sqlite3.Error, CacheError):  # gone or unreadable: the caller says so
                 return None
             return bytes(row[0]) if row is not None and isinstance(row[0], bytes) else None
@@ -211,10 +247,17 @@ class FactsCache:
     def put_encoded(self, items: Iterable[tuple[str, str, bytes]]) -> None:
         """Store (blob, language, ``codec.encode(facts)``) rows already encoded elsewhere
         (the parser processes encode what they send back, so nothing is encoded twice)."""
-        rows = [(blob, language, self.fingerprint, data) for blob, language, data in items]
-        self._run(
-            lambda db: db.executemany("insert or replace into facts values (?, ?, ?, ?)", rows)
-        )
+        heads, bodies = [], []
+        for blob, language, data in items:
+            head, body = codec.split(data)
+            heads.append((blob, language, self.fingerprint, head))
+            bodies.append((blob, language, self.fingerprint, body))
+
+        def write(db: sqlite3.Connection) -> None:
+            db.executemany("insert or replace into facts values (?, ?, ?, ?)", heads)
+            db.executemany("insert or replace into bodies values (?, ?, ?, ?)", bodies)
+
+        self._run(write)
 
     def get_total(self, key: str) -> bytes | None:
         """What was stored under ``key`` (a digest of all that decides it), if anything.
@@ -289,6 +332,7 @@ class FactsCache:
     def clear(self) -> int:
         self._decoded.clear()
         removed: int = self._run(lambda db: db.execute("delete from facts").rowcount)
+        self._run(lambda db: db.execute("delete from bodies"))
         self._run(lambda db: db.execute("delete from totals"))
         self._run(lambda db: db.commit())
         self._run(lambda db: db.execute("vacuum"))

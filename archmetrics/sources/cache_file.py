@@ -137,6 +137,7 @@ def open_database(path: Path, notices: list[str]) -> sqlite3.Connection:
         check(db)
         with contextlib.suppress(sqlite3.OperationalError):  # read-only: no totals kept
             db.execute(_TOTALS)  # a cache made before the totals table gains it, facts kept
+            db.execute(_BODIES)  # and the bodies table (its older facts are never read)
     except (Damaged, sqlite3.DatabaseError) as error:
         db.close()
         if isinstance(error, sqlite3.DatabaseError) and not is_damage(error):
@@ -148,6 +149,12 @@ def open_database(path: Path, notices: list[str]) -> sqlite3.Connection:
 # What a revision's facts add up to (a diff's coupling of one tree), by a digest of
 # everything that decides it (cache.py, ``FactsCache.get_total``).
 _TOTALS = "create table if not exists totals(key text primary key, data blob)"
+# The bodies of facts records (their call sites and statements), read on first use: a look-up
+# reads the head alone (codec.py, ``split``).
+_BODIES = (
+    "create table if not exists bodies(blob text, language text, parser text, data blob,"
+    " primary key(blob, language, parser))"
+)
 
 
 def check(db: sqlite3.Connection) -> None:
@@ -219,7 +226,7 @@ def _initialise(path: Path) -> None:
             "create table meta(key text primary key, value text);"
             "create table facts(blob text, language text, parser text, data blob,"
             " primary key(blob, language, parser));"
-            f"{_TOTALS};"
+            f"{_TOTALS};{_BODIES};"
         )
         db.executemany(
             "insert into meta values (?, ?)", [("application", APPLICATION), ("schema", SCHEMA)]

@@ -1,14 +1,17 @@
 """FileFacts to and from compact JSON, for the cache. Never pickle: a cache file is not trusted.
 
 An entry is three JSON documents on three lines: everything but the call sites and the
-statements, then the call sites, then the statements. ``decode`` reads the first and leaves
-the others as bytes until first read (:class:`~archmetrics.facts.Deferred`): a diff reads
-the statements of the files that changed, and coupling the call sites of files where a rule
-names one of their callees, and building those records was most of a warm diff's decode
-(docs/performance.md). The first document holds the count and CRC-32 of each of the other
-two (so damage to them is found at once, like any other damage), the file's callees and the
-digest of its statements' kinds and texts (a file that changed only in layout or comments
-is then found unchanged without decoding its statements).
+statements (the head), then the call sites, then the statements (the body). The facts
+cache keeps the head and the body apart (``split``): a look-up reads the head alone, and the
+body only when a file's statements or call sites are first used. ``decode`` reads the head
+and leaves the others as bytes until first read (:class:`~archmetrics.facts.Deferred`): a
+diff reads the statements of the files that changed, and coupling the call sites of files
+where a rule names one of their callees, and building those records was most of a warm
+diff's decode (docs/performance.md). The head holds the count and CRC-32 of each of the
+other two (so damage to them is found when they are read: then the cache forgets the
+entry), the file's callees and the digest of its statements' kinds and texts (a file that
+changed only in layout or comments is then found unchanged without decoding its
+statements).
 
 The path is left out, so one entry serves every path that holds the same blob; ``decode``
 puts the reader's path back. Anything malformed raises :class:`CodecError`.
@@ -39,7 +42,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 5
+FORMAT = 6
 
 _new = tuple.__new__
 
@@ -101,13 +104,22 @@ class _Spans(dict[tuple[int, int], Span]):
         return made
 
 
-# Where a record can be read again (the facts cache's row), a function that reads it: then
-# the records are not kept as bytes until first read but read again then (most never are)
+# Where a record's body can be read again (the facts cache's row), a function that reads it:
+# then the call sites and statements are not kept as bytes until first read but read again
+# then (most never are); and one that forgets the record, called when the body read then is
+# not the one its head describes (so that the next run measures the file again)
 Again = Callable[[], bytes | None]
+Forget = Callable[[], None]
+
+
+def split(record: bytes) -> tuple[bytes, bytes]:
+    """A record's head (its first line) and its body (the call sites and statements)."""
+    head, _, body = record.partition(b"\n")
+    return head, body
 
 
 def _deferred(
-    data: bytes,
+    data: bytes | None,
     count: Any,
     checksum: Any,
     what: str,
@@ -115,16 +127,22 @@ def _deferred(
     make: Callable[[Any], list[Any]],
     keys: frozenset[str] | None = None,
     digest: str | None = None,
-    again: tuple[Again, int] | None = None,
+    again: tuple[Again, int, Forget | None] | None = None,
 ) -> Deferred[Any]:
-    """Records left as bytes until first read; their count and checksum are checked now.
-    ``again``: the record's reader and the line these records are on; the bytes are then
-    dropped and read back on first use, checked against the same checksum."""
-    if type(count) is not int or zlib.crc32(data) != checksum:
+    """Records left as bytes until first read; their count and checksum are checked now if
+    the bytes are given. ``again``: the body's reader, the line of the body these records
+    are on, and what forgets the record; the bytes are then dropped (or never read) and read
+    on first use, checked against the checksum."""
+    if type(count) is not int or type(checksum) is not int:
+        raise CodecError(f"the {what} have no count or checksum")
+    if data is not None and zlib.crc32(data) != checksum:
         raise CodecError(f"the {what} do not match their checksum")
-    payload: Callable[[], bytes] = (
-        (lambda: data) if again is None else _reread(again, checksum, what, path)
-    )
+    if again is None:
+        if data is None:
+            raise CodecError(f"the {what} are missing")
+        payload: Callable[[], bytes] = lambda: data  # noqa: E731
+    else:
+        payload = _reread(again, checksum, what, path)
 
     def made() -> tuple[Any, ...]:
         try:
@@ -138,17 +156,22 @@ def _deferred(
     return Deferred(count, made, keys, digest)
 
 
-def _reread(again: tuple[Again, int], checksum: int, what: str, path: str) -> Callable[[], bytes]:
-    """A reader of one line of a record, which must be the line that was checked."""
-    read, line = again
+def _reread(
+    again: tuple[Again, int, Forget | None], checksum: int, what: str, path: str
+) -> Callable[[], bytes]:
+    """A reader of one line of a record's body, which must be the line its head describes."""
+    read, line, forget = again
 
     def payload() -> bytes:
-        record = read()
-        lines = record.split(b"\n", 2) if record is not None else []
-        if len(lines) != 3 or zlib.crc32(lines[line]) != checksum:
+        body = read()
+        lines = body.split(b"\n", 1) if body is not None else []
+        if len(lines) != 2 or zlib.crc32(lines[line]) != checksum:
+            if forget is not None:
+                forget()
             raise CodecError(
-                f"the {what} of {path} are no longer in the facts cache as they were when"
-                " read (was it cleared or changed meanwhile?); run the command again"
+                f"the {what} of {path} are no longer in the facts cache as its entry says"
+                " (was it cleared or changed meanwhile?); the entry is dropped: run the"
+                " command again"
             )
         return lines[line]
 
@@ -198,7 +221,12 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
 
 
 def _decode(
-    document: Any, calls: bytes, statements: bytes, path: str, again: Again | None
+    document: Any,
+    calls: bytes | None,
+    statements: bytes | None,
+    path: str,
+    again: Again | None,
+    forget: Forget | None,
 ) -> FileFacts:
     (
         fmt,
@@ -227,7 +255,7 @@ def _decode(
             path,
             _statements,
             digest=digest if isinstance(digest, str) else None,
-            again=None if again is None else (again, 2),
+            again=None if again is None else (again, 1, forget),
         ),
         functions=tuple(
             [
@@ -259,7 +287,7 @@ def _decode(
             path,
             _calls,
             frozenset(intern(callee) for callee in callees),
-            again=None if again is None else (again, 1),
+            again=None if again is None else (again, 0, forget),
         ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
@@ -268,15 +296,34 @@ def _decode(
     )
 
 
-def decode(data: bytes, path: str, again: Again | None = None) -> FileFacts:
+def decode(
+    data: bytes, path: str, again: Again | None = None, forget: Forget | None = None
+) -> FileFacts:
     """The facts ``encode`` wrote, now at ``path``; CodecError for anything else. ``again``:
-    reads ``data`` again (from the facts cache), so that the statements and call sites are
-    not held as bytes until first read (their checksums are checked now and then)."""
+    reads the record's body again (from the facts cache), so that the statements and call
+    sites are not held as bytes until first read (their checksums are checked now and then)."""
     lines = data.split(b"\n", 2)
     if len(lines) != 3:
         raise CodecError("not a facts record: not three lines")
+    return _decoded(lines[0], lines[1], lines[2], path, again, forget)
+
+
+def decode_head(head: bytes, path: str, again: Again, forget: Forget | None = None) -> FileFacts:
+    """The facts of a record's head (``split``), their call sites and statements read by
+    ``again`` on first use and checked then; CodecError for anything else."""
+    return _decoded(head, None, None, path, again, forget)
+
+
+def _decoded(
+    head: bytes,
+    calls: bytes | None,
+    statements: bytes | None,
+    path: str,
+    again: Again | None,
+    forget: Forget | None,
+) -> FileFacts:
     try:
-        return _decode(json.loads(lines[0]), lines[1], lines[2], path, again)
+        return _decode(json.loads(head), calls, statements, path, again, forget)
     except CodecError:
         raise
     except (ValueError, TypeError, KeyError) as error:

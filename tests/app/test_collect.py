@@ -138,8 +138,10 @@ def test_facts_parsed_in_a_run_read_their_statements_back_from_the_cache(
     snapshot = DirectorySnapshot(tmp_path / "src")
     with FactsCache(path) as cache:
         (facts,) = parse_all(snapshot, select(snapshot, LanguageTable.default()), cache=cache)
+    head, body = codec.split(codec.encode(facts_of("x = 1\n", "python")))
     with sqlite3.connect(path) as db:  # rewritten once the run has closed the cache
-        db.execute("update facts set data = ?", (codec.encode(facts_of("x = 1\n", "python")),))
+        db.execute("update facts set data = ?", (head,))
+        db.execute("update bodies set data = ?", (body,))
     with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
         facts.statements.items()
     assert facts.functions[0].complexity == 2  # what was decoded stays

@@ -302,13 +302,17 @@ def test_damaged_statements_in_the_cache_are_a_one_line_error(
     cache = tmp_path / "facts.sqlite3"
     first = diff(integration, capsys, "--base", "v1", "--head", "v2", "--cache-path", str(cache))
     db = sqlite3.connect(cache)
-    for rowid, data in db.execute("select rowid, data from facts").fetchall():
-        head, calls, statements = data.split(b"\n")
+    rows = db.execute(
+        "select f.rowid, b.rowid, f.data, b.data from facts f join bodies b"
+        " on b.blob=f.blob and b.language=f.language and b.parser=f.parser"
+    ).fetchall()
+    for head_row, body_row, head, body in rows:
+        calls, statements = body.split(b"\n")
         bad = statements.replace(b'"import"', b"1")  # well-formed JSON, not statements
         document = json.loads(head)
         document[2][1] = zlib.crc32(bad)  # a checksum that matches: found only when read
-        damaged = b"\n".join((_json(document), calls, bad))
-        db.execute("update facts set data=? where rowid=?", (damaged, rowid))
+        db.execute("update facts set data=? where rowid=?", (_json(document), head_row))
+        db.execute("update bodies set data=? where rowid=?", (calls + b"\n" + bad, body_row))
     db.execute("delete from totals")  # the kept file changes: the statements must be read
     db.commit()
     db.close()
