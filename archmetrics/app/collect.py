@@ -99,6 +99,8 @@ def parse_all(
     def deliver(entry: _Todo, answer: Parsed) -> None:
         path, language = entry.item.file.path, entry.item.language
         progress.advance()
+        if blobs is not None:
+            blobs[path] = entry.blob
         if answer.encoded is None:  # over a limit: reported, never cached (it may pass later)
             results[entry.index] = not_measured(path, language, answer.failure or "unknown")
             return
@@ -144,7 +146,13 @@ def worker_limits(settings: LimitSettings, macros: MacroSettings) -> WorkerLimit
 
 
 def _payload(snapshot: Snapshot, entry: _Todo) -> Task:
-    data = entry.data if entry.data is not None else snapshot.read(entry.item.file)
+    data = entry.data
+    if data is None:
+        data = snapshot.read(entry.item.file)
+        # a work tree's file whose blob git's index gave (unchanged since it was staged, as
+        # git sees it) may hold other bytes (a line-ending conversion): its facts are kept
+        # under the blob of the bytes parsed, as for every other file
+        entry.blob = blob_hash(data)
     return entry.item.file.path, data, entry.item.language
 
 

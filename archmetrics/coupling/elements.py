@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from pathlib import PurePosixPath
 
 from archmetrics.facts import Language
 from archmetrics.parsers import DEFAULT_EXTENSIONS
@@ -29,18 +28,27 @@ class Element:
     languages: tuple[str, ...]
 
 
+def suffix(path: str) -> str:
+    """The ending of ``path``'s last part, as ``PurePosixPath(path).suffix`` gives it
+    (``.c``; none for ``.bashrc`` or ``a.``), without building a path object: grouping a
+    tree's files asks it of every file, twice per diff."""
+    name = path[path.rfind("/") + 1 :]
+    dot = name.rfind(".")
+    return name[dot:] if 0 < dot < len(name) - 1 else ""
+
+
 def _default_language(path: str) -> str | None:
-    return DEFAULT_EXTENSIONS.get(PurePosixPath(path).suffix.lower())
+    return DEFAULT_EXTENSIONS.get(suffix(path).lower())
 
 
 def _is_c_family(path: str) -> bool:
-    return PurePosixPath(path).suffix.lower() in C_FAMILY_SUFFIXES
+    return suffix(path).lower() in C_FAMILY_SUFFIXES
 
 
 def component_name(path: str) -> str:
     """The name of the C/C++ component ``path`` belongs to: its folder and stem (``src/foo``)."""
-    pure = PurePosixPath(path)
-    return str(pure.with_suffix("")) if pure.suffix else path
+    ending = suffix(path)
+    return path[: len(path) - len(ending)] if ending else path
 
 
 def _languages(files: Iterable[str], language_of: Callable[[str], str | None]) -> tuple[str, ...]:
@@ -80,7 +88,7 @@ def group_elements(
 
 
 def _brace_name(stem: str, files: list[str]) -> str:
-    suffixes = sorted(PurePosixPath(f).suffix.lstrip(".") for f in files)
+    suffixes = sorted(suffix(f).lstrip(".") for f in files)
     return f"{stem}.{{{','.join(suffixes)}}}"
 
 

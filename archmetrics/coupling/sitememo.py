@@ -52,21 +52,21 @@ def site_key(
 ) -> str | None:
     """The key of ``path``'s sites, or None when a file it depends on has no known content.
     ``reach``: the files it reaches, itself first, in order; ``bindings``: its dependencies'
-    names and the tree files they resolve to."""
+    names and the tree files they resolve to. Paths and content ids hold no NUL (git's paths
+    cannot), so joining them with NULs is unambiguous; the bindings are JSON."""
     identity = memo.identity
-    named = [path, *reach, *element_files]
-    if any(not identity.get(p) for p in named):
-        return None
-    document = [
-        RECORD,
-        memo.context,
-        path,
-        [[p, identity[p]] for p in reach],
-        [[p, identity[p]] for p in element_files],
-        list(bindings),
-    ]
-    text = json.dumps(document, separators=(",", ":"))
-    return RECORD + ":" + hashlib.sha256(text.encode()).hexdigest()
+    parts = [RECORD, memo.context, path]
+    for group in (reach, element_files):
+        parts.append(str(len(group)))
+        for p in group:
+            content = identity.get(p)
+            if not content:
+                return None
+            parts.append(p)
+            parts.append(content)
+    parts.append(json.dumps(bindings, separators=(",", ":")))
+    text = "\0".join(parts)
+    return RECORD + ":" + hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
 def encode_sites(path: str, sites: Sequence[LinkSite]) -> bytes | None:

@@ -199,12 +199,33 @@ class IndexSnapshot(_BlobReader):
 
 
 class WorktreeSnapshot(DirectorySnapshot):
-    """The working tree: tracked and untracked files that .gitignore does not exclude."""
+    """The working tree: tracked and untracked files that .gitignore does not exclude.
+
+    A tracked file git finds unchanged since it was staged comes with the index's blob, so
+    it is neither read nor hashed unless its facts must be parsed (then the bytes read are
+    hashed, as every file's are): a diff of the work tree after editing one file reads that
+    file, not every file (docs/performance.md)."""
 
     def __init__(self, repo: git.Repo):
         root = toplevel(repo)
         paths = _ls(repo, "ls-files", "-z", "--cached", "--others", "--exclude-standard")
         super().__init__(root, sorted(set(paths)), label=WORKTREE)
+        self._hashes = _unchanged_blobs(repo)
+
+
+def _unchanged_blobs(repo: git.Repo) -> dict[str, str]:
+    """Path -> blob of each regular tracked file that ``git diff-files`` (the plumbing: it
+    compares without writing the index, and compares the bytes of an entry whose stat data
+    cannot tell) finds as staged; not an entry marked assume-unchanged or skip-worktree
+    (``ls-files -v`` tags those in other letters), nor an unmerged one."""
+    changed = set(_ls(repo, "diff-files", "--name-only", "-z"))
+    found = {}
+    for entry in _ls(repo, "ls-files", "-s", "-v", "-z"):
+        meta, path = entry.split("\t", 1)
+        tag, mode, blob, stage = meta.split(" ")
+        if tag == "H" and stage == "0" and mode in ("100644", "100755") and path not in changed:
+            found[path] = blob
+    return found
 
 
 def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:

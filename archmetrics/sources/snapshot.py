@@ -124,7 +124,8 @@ class DirectorySnapshot:
         found = []
         for path in self._walk():
             full = self.root / path
-            if full.is_file() and not full.is_symlink():
+            # a path with a known blob is a regular file (git said so): no stat asked
+            if path in self._hashes or (full.is_file() and not full.is_symlink()):
                 shown = quote_path(path)
                 if shown != path:
                     self._on_disk[shown] = path

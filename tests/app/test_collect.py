@@ -13,9 +13,9 @@ from archmetrics.app.collect import parse_all, select
 from archmetrics.app.workers import FORK_BELOW as PARALLEL_THRESHOLD
 from archmetrics.cli import main
 from archmetrics.parsers import LanguageTable
-from archmetrics.sources import codec
+from archmetrics.sources import WORKTREE, codec, open_snapshot
 from archmetrics.sources.cache import FactsCache
-from archmetrics.sources.snapshot import DirectorySnapshot
+from archmetrics.sources.snapshot import DirectorySnapshot, blob_hash
 from tests.gitrepo import GitRepo
 from tests.harness import facts_of
 
@@ -145,3 +145,28 @@ def test_facts_parsed_in_a_run_read_their_statements_back_from_the_cache(
     with pytest.raises(codec.CodecError, match="no longer in the facts cache"):
         facts.statements.items()
     assert facts.functions[0].complexity == 2  # what was decoded stays
+
+
+def test_a_worktree_file_whose_bytes_differ_from_its_blob_is_kept_under_its_bytes(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    # with core.autocrlf the checkout holds CRLF where the blob holds LF, and git finds the
+    # file unchanged: the index's blob is taken for the look-up, but facts parsed from the
+    # bytes on disk are kept under those bytes' blob, never under another's
+    repo.git("config", "core.autocrlf", "true")
+    repo.commit("one", files={"m.py": "x = 1\n"})
+    (repo.root / "m.py").unlink()
+    repo.git("checkout", "--", "m.py")
+    on_disk = (repo.root / "m.py").read_bytes()
+    assert on_disk == b"x = 1\r\n"
+    snapshot = open_snapshot(repo.root, WORKTREE)
+    [file] = snapshot.files()
+    assert file.blob == blob_hash(b"x = 1\n")  # git's view: unchanged
+    blobs: dict[str, str] = {}
+    with FactsCache(tmp_path / "cache.sqlite3") as cache:
+        selected = select(snapshot, LanguageTable.default())
+        (facts,) = parse_all(snapshot, selected, cache=cache, blobs=blobs)
+        assert facts.parsed and facts.sloc == 1
+        assert blobs == {"m.py": blob_hash(on_disk)}
+        assert cache.get(blob_hash(on_disk), "python", "m.py") is not None
+        assert cache.get(blob_hash(b"x = 1\n"), "python", "m.py") is None

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import PurePosixPath
+
+from hypothesis import given
+from hypothesis import strategies as st
+
 from archmetrics.coupling import Element, group_elements
+from archmetrics.coupling.elements import component_name, suffix
 from tests.coupling.trees import measure
 
 
@@ -62,3 +68,15 @@ def test_per_file_counts_the_pair_include_as_coupling() -> None:
     report = measure(files, per_file=True)
     assert report.element("src/queue.c").s_e == 1
     assert report.element("src/queue.h").s_a == 1
+
+
+_PART = st.text(alphabet="ab.c_-", min_size=1, max_size=6).filter(lambda p: p not in {".", ".."})
+
+
+@given(st.lists(_PART, min_size=1, max_size=4).map("/".join))
+def test_a_paths_ending_and_component_are_what_pathlib_gives(path: str) -> None:
+    # read from the string (grouping asks every file, twice per diff), as PurePosixPath reads
+    # a normalized git path: `.bashrc` and `a.` have no ending, `a.b.c` ends in `.c`
+    pure = PurePosixPath(path)
+    assert suffix(path) == pure.suffix
+    assert component_name(path) == (str(pure.with_suffix("")) if pure.suffix else path)

@@ -35,6 +35,25 @@ def test_revision_blobs_are_git_blob_ids(repo: GitRepo) -> None:
     assert file.blob == repo.git("rev-parse", "HEAD:a.py").strip() == blob_hash(b"x = 1\n")
 
 
+def test_worktree_files_unchanged_since_staged_carry_the_index_blob(repo: GitRepo) -> None:
+    # a tracked file git finds as staged is neither read nor hashed: its blob is the index's;
+    # a modified, an untracked and an assume-unchanged file (whose change git would not see)
+    # carry none and are hashed from their bytes; a skip-worktree file not on disk is absent
+    files = {"same.py": "x = 1\n", "edited.py": "y = 1\n", "hidden.py": "z = 1\n"}
+    repo.commit("one", files={**files, "sparse.py": "w = 1\n"})
+    repo.git("update-index", "--assume-unchanged", "hidden.py")
+    repo.git("update-index", "--skip-worktree", "sparse.py")
+    (repo.root / "sparse.py").unlink()
+    repo.write({"edited.py": "y = 2\n", "hidden.py": "z = 2\n", "new.py": "v = 1\n"})
+    blobs = {f.path: f.blob for f in open_snapshot(repo.root, WORKTREE).files()}
+    assert blobs == {
+        "same.py": blob_hash(b"x = 1\n"),
+        "edited.py": "",
+        "hidden.py": "",
+        "new.py": "",
+    }
+
+
 def test_unknown_revision_is_a_one_line_error(repo: GitRepo) -> None:
     repo.commit("one", files={"a.py": "x = 1\n"})
     with pytest.raises(SourceError, match="unknown revision 'nope'"):
