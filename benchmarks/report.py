@@ -139,7 +139,7 @@ def _speed_row(row: Row) -> str:
     files = f"{row.files[0]} / {row.files[1]}" if row.files else "-"
     if row.tree is not None:
         files += f" ({row.tree.bytes / 1e6:.1f} MB)"
-    goal = f"≥ {row.goal:g}x" if row.goal else "(reference)"
+    goal = f"≥ {row.goal:.3g}x" if row.goal else "(reference)"
     if row.theirs is None:
         return f"| {row.measure} | {files} | {_pair(row.ours)} | {row.peer} | - | {goal} | - |"
     wall, cpu = row.theirs.wall / row.ours.wall, row.theirs.cpu / row.ours.cpu

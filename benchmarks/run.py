@@ -2,8 +2,8 @@
 
 Run from a clean clone:
     .venv/bin/pip install -e '.[bench]' && .venv/bin/python benchmarks/run.py
-Options: --repeat N (runs per measure, median taken), --jobs N, --only scan-c scan-py diff growth,
---single (archmetrics with one worker too), --releases A B.
+Options: --repeat N (runs per measure, median taken), --jobs N, --only scan-c scan-py diff
+edit growth, --single (archmetrics with one worker too), --releases A B.
 Downloads and trees are kept in benchmarks/.work (gitignored) and reused. Prints a Markdown
 table for docs/performance.md and writes it, with every run, to benchmarks/.work/results.*.
 Not part of the test suite.
@@ -26,7 +26,7 @@ from corpus import BenchError, Tree
 from measure import Summary, power_fit, repeat
 
 HERE = Path(__file__).resolve().parent
-TASKS = ("scan-c", "scan-py", "diff", "growth")
+TASKS = ("scan-c", "scan-py", "diff", "edit", "growth")
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,6 +158,40 @@ def diff_rows(
     return rows
 
 
+EDITED = "numpy/_core/src/multiarray/ctors.c"  # if the head has it; else its largest C file
+
+
+def edit_rows(bench: Bench, history: Path, tag: str) -> list[report.Result]:
+    """issue 14: ``diff --base HEAD --head WORKTREE`` with a warm cache, each run after a new
+    edit of one C file (a function appended), against ``scan`` of that file (its facts
+    cached by the diff); goal: the diff at most 3x the scan (a speed-up of at least 1/3)."""
+    clone = bench.work / "edit"
+    if clone.exists():
+        shutil.rmtree(clone)
+    corpus.git(bench.work, "clone", "-q", "--shared", str(history), str(clone))
+    corpus.git(clone, "checkout", "-q", tag)
+    target = clone / EDITED
+    if not target.is_file():
+        target = max(clone.rglob("*.c"), key=lambda p: p.stat().st_size)
+    cache = bench.work / "edit-cache.sqlite3"
+    _remove(cache)
+    tool = bench.tool("archmetrics")
+    diff = [tool, "diff", "-C", str(clone), "--base", "HEAD", "--head", "WORKTREE", "-q"]
+    diff += ["-j", str(bench.jobs), "--format", "json", "--cache-path", str(cache)]
+    bench.repeat("edit.warm-up", diff)  # both trees' facts and coupling cached
+    edits = iter(range(1_000_000))
+
+    def edit() -> None:
+        with target.open("a") as file:
+            file.write(f"\nint archmetrics_bench_edit_{next(edits)}(int x) {{ return x; }}\n")
+
+    ours = bench.repeat("edit.diff", diff, before=edit)
+    scan = [tool, "scan", str(target), "-q", "--format", "json", "--cache-path", str(cache)]
+    theirs = bench.repeat("edit.scan", scan)
+    measure = f"diff HEAD..WORKTREE after editing {target.relative_to(clone)}, warm"
+    return [report.Row(measure, None, ours, theirs, "one-file scan", 1 / 3)]
+
+
 def _remove(path: Path) -> None:
     for candidate in (path, path.with_name(path.name + "-journal")):
         candidate.unlink(missing_ok=True)
@@ -217,6 +251,7 @@ def run(
             bench, corpus.subset_tree(head, corpus.PYTHON, bench.work / "trees/python")
         ),
         "diff": lambda: diff_rows(bench, history, sources, tags),
+        "edit": lambda: edit_rows(bench, history, tags[1]),
         "growth": lambda: growth(bench, head),
     }
     rows: list[report.Result] = []

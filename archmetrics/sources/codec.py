@@ -19,11 +19,12 @@ puts the reader's path back. Anything malformed raises :class:`CodecError`.
 
 from __future__ import annotations
 
+import functools
 import json
 import zlib
 from collections.abc import Callable
 from sys import intern
-from typing import Any
+from typing import Any, ParamSpec, TypeVar
 
 from archmetrics.facts import (
     Argument,
@@ -220,8 +221,29 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
     ]
 
 
+_T = TypeVar("_T")
+_P = ParamSpec("_P")
+
+
+def _malformed_is_codec_error(read: Callable[_P, _T]) -> Callable[_P, _T]:
+    """``read`` with what a malformed record raises (bad JSON, a wrong shape or type) turned
+    into :class:`CodecError`."""
+
+    @functools.wraps(read)
+    def checked(*args: _P.args, **kwargs: _P.kwargs) -> _T:
+        try:
+            return read(*args, **kwargs)
+        except CodecError:
+            raise
+        except (ValueError, TypeError, KeyError) as error:
+            raise CodecError(f"not a facts record: {error}") from error
+
+    return checked
+
+
+@_malformed_is_codec_error
 def _decode(
-    document: Any,
+    head: bytes,
     calls: bytes | None,
     statements: bytes | None,
     path: str,
@@ -240,7 +262,7 @@ def _decode(
         warnings,
         parsed,
         generated,
-    ) = document
+    ) = json.loads(head)
     if fmt != FORMAT:
         raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
     spans = _Spans()
@@ -305,26 +327,10 @@ def decode(
     lines = data.split(b"\n", 2)
     if len(lines) != 3:
         raise CodecError("not a facts record: not three lines")
-    return _decoded(lines[0], lines[1], lines[2], path, again, forget)
+    return _decode(lines[0], lines[1], lines[2], path, again, forget)
 
 
 def decode_head(head: bytes, path: str, again: Again, forget: Forget | None = None) -> FileFacts:
     """The facts of a record's head (``split``), their call sites and statements read by
     ``again`` on first use and checked then; CodecError for anything else."""
-    return _decoded(head, None, None, path, again, forget)
-
-
-def _decoded(
-    head: bytes,
-    calls: bytes | None,
-    statements: bytes | None,
-    path: str,
-    again: Again | None,
-    forget: Forget | None,
-) -> FileFacts:
-    try:
-        return _decode(json.loads(head), calls, statements, path, again, forget)
-    except CodecError:
-        raise
-    except (ValueError, TypeError, KeyError) as error:
-        raise CodecError(f"not a facts record: {error}") from error
+    return _decode(head, None, None, path, again, forget)
