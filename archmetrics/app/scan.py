@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
@@ -12,6 +13,12 @@ from archmetrics.app.progress import Progress
 from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import ExcludedFile
 from archmetrics.complexity import file_metrics, totals
+from archmetrics.complexity.thresholds import (
+    Threshold,
+    Unit,
+    check_thresholds,
+    parse_threshold,
+)
 from archmetrics.config import Settings
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import ScanReport
@@ -30,6 +37,7 @@ class ScanRequest:
     settings: Settings
     jobs: int = 0
     plain_directory: bool = False  # read the one path given as a folder, even inside git
+    gates: tuple[str, ...] = ()  # thresholds to check (--fail-on 'vg(function) > 15')
 
 
 def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
@@ -85,7 +93,9 @@ def _nothing_to_measure(request: ScanRequest, snapshot: Snapshot, prefixes: tupl
 def run_scan(
     request: ScanRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> ScanReport:
-    """Facts and metrics for every source file under the requested paths."""
+    """Facts and metrics for every source file under the requested paths, and every unit
+    that fails one of the request's thresholds."""
+    thresholds = tuple(parse_threshold(g) for g in request.gates)  # bad ones before any work
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
@@ -110,7 +120,7 @@ def run_scan(
     limits = worker_limits(request.settings.limits, request.settings.macros)
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
     metrics = tuple(file_metrics(f) for f in facts)
-    return ScanReport(
+    report = ScanReport(
         root=str(root),
         revision=snapshot.label,
         facts=facts,
@@ -118,4 +128,40 @@ def run_scan(
         totals=totals(metrics),
         coupling=measure(facts, request.settings, root),
         excluded=tuple(excluded),
+        gates=tuple(t.text for t in thresholds),
     )
+    if not thresholds:
+        return report
+    failures = check_thresholds(thresholds, _units(report, thresholds))
+    return dataclasses.replace(report, failures=failures)
+
+
+def _units(report: ScanReport, thresholds: tuple[Threshold, ...]) -> dict[str, list[Unit]]:
+    """The functions, files, elements and the total of ``report`` as threshold units (only
+    the kinds some threshold names)."""
+    wanted = {t.unit for t in thresholds}
+    units: dict[str, list[Unit]] = {}
+    if "function" in wanted:
+        units["function"] = [
+            Unit(fn.qualified_name, f.path, fn.line, {"vg": fn.vg, "loc": fn.loc})
+            for f in report.files
+            for fn in f.functions
+        ]
+    if "file" in wanted:
+        units["file"] = [
+            Unit(f.path, f.path, None, {"vg": f.vg, "loc": f.loc, "sloc": f.sloc,
+                                        "functions": len(f.functions), "warnings": len(f.warnings)})
+            for f in report.files
+        ]  # fmt: skip
+    if "element" in wanted:
+        units["element"] = [
+            Unit(r.element, None, None, {"vg": r.vg, "loc": r.loc, "sloc": r.sloc, "s_a": r.s_a,
+                                         "s_e": r.s_e, "d_a": r.d_a, "d_e": r.d_e})
+            for r in report.element_rows()
+        ]  # fmt: skip
+    if "total" in wanted:
+        t = report.totals
+        numbers = {"files": t.files, "functions": t.functions, "loc": t.loc, "sloc": t.sloc,
+                   "vg": t.vg, "warnings": t.warnings, "unparsed": t.unparsed}  # fmt: skip
+        units["total"] = [Unit("total", None, None, numbers)]
+    return units

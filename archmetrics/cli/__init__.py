@@ -20,6 +20,7 @@ from archmetrics.changeset.locations import BadPattern
 from archmetrics.cli import measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
+from archmetrics.complexity.thresholds import ThresholdError
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
 from archmetrics.parsers import UnknownLanguage
@@ -46,6 +47,7 @@ CANNOT_MEASURE = (
     UsageError,
     BadPattern,
     GateError,
+    ThresholdError,
     RulePackError,
     SeriesError,
     ManifestError,

@@ -12,6 +12,7 @@ from typing import NoReturn
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
+from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import LimitSettings, MacroSettings, Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.printable import one_line
@@ -167,14 +168,26 @@ def _detail(args: argparse.Namespace, text: str) -> None:
         print(f"archmetrics: {one_line(text)}", file=sys.stderr)
 
 
-def gate_status(failures: Sequence[GateFailure], args: argparse.Namespace) -> int:
+SHOWN_ON_STDERR = 50  # failures printed on stderr, at most (a report lists them all)
+
+
+def gate_status(
+    failures: Sequence[GateFailure | ThresholdFailure], args: argparse.Namespace
+) -> int:
     """Exit 1 if a gate failed, else 0. Each failure goes to stderr unless the report itself
     showed it on stdout (a table or Markdown, every report lists its failed gates): a
-    failure is printed once, and a report written to a file or as data still names it."""
+    failure is printed once, and a report written to a file or as data still names it;
+    past ``SHOWN_ON_STDERR`` failures (a threshold thousands of functions fail), a count."""
     shown = args.output is None and args.format in (OutputFormat.TABLE, OutputFormat.MARKDOWN)
     if not shown:
-        for failure in failures:
+        for failure in failures[:SHOWN_ON_STDERR]:
             print(f"archmetrics: {one_line(str(failure))}", file=sys.stderr)
+        if len(failures) > SHOWN_ON_STDERR:
+            more = len(failures) - SHOWN_ON_STDERR
+            print(
+                f"archmetrics: ... and {more} more failures (the report lists them)",
+                file=sys.stderr,
+            )
     return EXIT_GATE if failures else EXIT_OK
 
 

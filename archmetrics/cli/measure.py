@@ -89,12 +89,17 @@ def scan_command(args: argparse.Namespace) -> int:
     settings = settings_for(paths[0] if paths else Path.cwd())
     fmt = OutputFormat(args.format)
     request = ScanRequest(
-        paths=paths, rev=args.rev, settings=settings, jobs=args.jobs, plain_directory=args.sample
+        paths=paths,
+        rev=args.rev,
+        settings=settings,
+        jobs=args.jobs,
+        plain_directory=args.sample,
+        gates=tuple(args.fail_on),
     )
     with facts_cache(args, settings) as cache:
         report = run_scan(request, progress_for(fmt, args.quiet), cache)
     emit(render_scan(report, fmt, Grouping(args.by)), args.output)
-    return EXIT_OK
+    return gate_status(report.failures, args)
 
 
 def rules_command(args: argparse.Namespace) -> int:

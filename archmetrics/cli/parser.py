@@ -120,6 +120,14 @@ def build_parser() -> argparse.ArgumentParser:
     scan.add_argument(
         "--sample", action="store_true", help="scan the sample shipped with archmetrics"
     )
+    scan.add_argument(
+        "--fail-on",
+        action="append",
+        default=[],
+        metavar="EXPR",
+        help="a threshold, e.g. 'vg(function) > 15' or 'loc(file) > 1000 or vg(file) > 200';"
+        " exit 1 when a function, file, element or the total fails it (repeatable)",
+    )
     add_output(scan, [f.value for f in OutputFormat])
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"

@@ -75,6 +75,23 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
         "totals": totals_dict(report.totals),
         "elements": coupling_rows.elements_json(report),
         "excluded": [x.to_dict() for x in report.excluded],
+        "gates": [
+            {
+                "gate": gate,
+                "failed": any(f.threshold.text == gate for f in report.failures),
+                "failures": [
+                    {
+                        "name": f.unit.name,
+                        "path": f.unit.path,
+                        "line": f.unit.line,
+                        "values": {field: f.unit.values[field] for field in f.threshold.fields},
+                    }
+                    for f in report.failures
+                    if f.threshold.text == gate
+                ],
+            }
+            for gate in report.gates
+        ],
     }
 
 

@@ -14,6 +14,7 @@ from archmetrics.reports.model import (
     SeriesReport,
 )
 from archmetrics.reports.printable import shown_warnings
+from archmetrics.reports.table_report import gate_lines
 
 
 def escape(cell: object) -> str:
@@ -62,6 +63,11 @@ def render_scan(report: ScanReport, grouping: str) -> str:
         parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
     if report.excluded:
         parts.append("".join(f"- excluded `{x.path}`: {x.reason}\n" for x in report.excluded))
+    if report.gates:
+        verdict = f"**{len(report.failures)} failing unit(s)**" if report.failures else "all hold"
+        lines = "".join(f"- {line}\n" for line in gate_lines(report))
+        gates = ", ".join(f"`{gate}`" for gate in report.gates)
+        parts.append(f"\n**Gates** ({gates}): {verdict}\n\n{lines}")
     return "\n".join(parts)
 
 

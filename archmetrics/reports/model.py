@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.coupling import CouplingReport
 from archmetrics.facts import FileFacts, ParseWarning
 
@@ -28,6 +29,8 @@ class ScanReport:
     totals: Totals
     coupling: CouplingReport | None = None
     excluded: tuple[ExcludedFile, ...] = ()  # left out by the configuration's `exclude`
+    gates: tuple[str, ...] = ()  # the thresholds checked (--fail-on)
+    failures: tuple[ThresholdFailure, ...] = ()  # every unit that failed one
 
     def element_rows(self) -> list[ElementRow]:
         """Per element: its files, summed λ, SLOC and v_g, and its coupling."""

@@ -88,7 +88,20 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
+    extra += gate_lines(report)
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
+
+
+SHOWN_FAILURES = 50  # failed units listed in a table, Markdown or on stderr; JSON lists all
+
+
+def gate_lines(report: ScanReport) -> list[str]:
+    """The scan's failed thresholds, one line per failing unit, at most ``SHOWN_FAILURES``."""
+    lines = [str(f) for f in report.failures[:SHOWN_FAILURES]]
+    if len(report.failures) > SHOWN_FAILURES:
+        more = len(report.failures) - SHOWN_FAILURES
+        lines.append(f"... and {more} more failing units (--format json lists them all)")
+    return lines
 
 
 def render_diff(report: DiffReport, color: bool = False) -> str:

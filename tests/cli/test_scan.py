@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
@@ -227,3 +228,63 @@ def test_verbose_adds_cache_and_time_detail_and_quiet_stays_quiet(
     assert "1 files' facts served, 0 parsed" in capsys.readouterr().err
     assert main(scan) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_scan_thresholds_fail_the_run_and_name_every_failing_unit(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    repo.commit("one", files={"m.py": PY_V2, "src/m.c": C_SRC, "src/m.h": "int m(int a);\n"})
+    scan = ["scan", str(repo.root), "-q", "--no-cache"]
+    # the table shows each failure once, on stdout; exit 1
+    assert main([*scan, "--fail-on", "vg(function) >= 2"]) == 1
+    out, err = capsys.readouterr()
+    assert err == ""
+    assert out.count("gate failed") == 3
+    assert "gate failed: vg(function) >= 2: m.py:4 f (vg = 2)" in out
+    assert "gate failed: vg(function) >= 2: m.py:10 g (vg = 3)" in out  # the comprehension's if
+    assert "gate failed: vg(function) >= 2: src/m.c:2 m (vg = 2)" in out
+    # JSON: every threshold and its failing units; the failures on stderr, once each
+    assert main([*scan, "--format", "json", "--fail-on", "vg(total) > 100",
+                 "--fail-on", "loc(file) > 1 and functions(file) >= 2"]) == 1  # fmt: skip
+    out, err = capsys.readouterr()
+    gates = json.loads(out)["gates"]
+    assert gates[0] == {"gate": "vg(total) > 100", "failed": False, "failures": []}
+    assert gates[1]["failures"] == [
+        {"name": "m.py", "path": "m.py", "line": None, "values": {"loc": 7, "functions": 2}}
+    ]
+    assert err.splitlines() == [
+        "archmetrics: gate failed: loc(file) > 1 and functions(file) >= 2: m.py"
+        " (loc = 7, functions = 2)"
+    ]
+    # Markdown names the thresholds and the verdict; a threshold that holds is exit 0
+    assert main([*scan, "--format", "markdown", "--fail-on", "vg(element) > 50"]) == 0
+    assert "**Gates** (`vg(element) > 50`): all hold" in capsys.readouterr().out
+
+
+def test_a_threshold_failed_by_many_units_lists_the_first_fifty(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    body = "".join(f"def f{i}(a):\n    return a\n\n\n" for i in range(60))
+    repo.commit("one", files={"many.py": body})
+    scan = ["scan", str(repo.root), "-q", "--no-cache", "--fail-on", "vg(function) > 0"]
+    assert main(scan) == 1
+    out = capsys.readouterr().out
+    assert out.count("gate failed:") == 50
+    assert "... and 10 more failing units (--format json lists them all)" in out
+    assert main([*scan, "--format", "json"]) == 1
+    out, err = capsys.readouterr()
+    assert len(json.loads(out)["gates"][0]["failures"]) == 60
+    assert err.count("gate failed:") == 50 and "... and 10 more failures" in err
+
+
+def test_a_bad_threshold_is_exit_2_before_any_work(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    repo.commit("one", files={"m.py": PY_V1})
+    cache = tmp_path / "cache.sqlite3"
+    argv = ["scan", str(repo.root), "-q", "--cache-path", str(cache), "--fail-on", "vg > 3"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "is not FIELD(UNIT) OP NUMBER" in err
+    with sqlite3.connect(cache) as db:  # nothing was parsed
+        assert db.execute("select count(*) from facts").fetchone()[0] == 0

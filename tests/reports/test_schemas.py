@@ -68,9 +68,11 @@ def test_every_scan_document_holds_to_its_schema(
 ) -> None:
     validator = _validator("scan-1.schema.json")
     sample = _document(capsys, "scan", "--sample")
-    scanned = _document(capsys, "scan", str(history.root))
+    gates = ["--fail-on", "vg(function) > 1", "--fail-on", "s_e(element) > 99"]
+    scanned = _document(capsys, "scan", str(history.root), *gates)
     assert scanned["excluded"] and scanned["totals"]["warnings"]  # the optional parts occur
     assert any(e["link_sites"] for e in scanned["elements"])
+    assert [g["failed"] for g in scanned["gates"]] == [True, False]
     for document in (sample, scanned):
         validator.validate(document)
 

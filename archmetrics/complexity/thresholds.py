@@ -1,0 +1,137 @@
+"""Thresholds: absolute limits a scan checks (``--fail-on 'vg(function) > 15'``), as xenon and
+lizard users expect of a complexity gate.
+
+A threshold is one or more conditions ``FIELD(UNIT) OP NUMBER`` joined by ``and`` / ``or``
+(``and`` binds tighter), every condition on the same UNIT: ``function``, ``file``,
+``element`` or ``total``. FIELD is one of the unit's numbers (:data:`FIELDS`); OP one of
+``> >= < <= == !=``. The expression says when a unit fails: ``vg(function) > 15 and
+loc(function) > 60`` fails every function over both limits, each named with its file and line.
+"""
+
+from __future__ import annotations
+
+import operator
+import re
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+_OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
+    ">=": operator.ge,
+    "<=": operator.le,
+    "==": operator.eq,
+    "!=": operator.ne,
+    ">": operator.gt,
+    "<": operator.lt,
+}
+_CONDITION = re.compile(
+    r"^\s*(?P<field>[a-z_]+)\s*\(\s*(?P<unit>[a-z]+)\s*\)\s*"
+    r"(?P<op>>=|<=|==|!=|>|<)\s*(?P<number>-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)\s*$"
+)
+_JOIN = re.compile(r"\s+(and|or)\s+")
+
+FIELDS: Mapping[str, tuple[str, ...]] = {
+    "function": ("vg", "loc"),
+    "file": ("vg", "loc", "sloc", "functions", "warnings"),
+    "element": ("vg", "loc", "sloc", "s_a", "s_e", "d_a", "d_e"),
+    "total": ("files", "functions", "loc", "sloc", "vg", "warnings", "unparsed"),
+}
+"""The numbers each unit has (docs/metrics.md: λ is ``loc``, v_g is ``vg``)."""
+
+
+class ThresholdError(ValueError):
+    """A threshold that cannot be read; the message says what is wrong with it."""
+
+
+@dataclass(frozen=True, slots=True)
+class Condition:
+    field: str
+    op: str
+    limit: float
+
+    def holds(self, values: Mapping[str, int]) -> bool:
+        return _OPERATORS[self.op](float(values[self.field]), self.limit)
+
+
+@dataclass(frozen=True, slots=True)
+class Threshold:
+    """``any`` of the groups, each ``all`` of its conditions, on one ``unit``."""
+
+    text: str
+    unit: str
+    groups: tuple[tuple[Condition, ...], ...]
+
+    def fails(self, values: Mapping[str, int]) -> bool:
+        return any(all(c.holds(values) for c in group) for group in self.groups)
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(c.field for group in self.groups for c in group))
+
+
+def parse_threshold(text: str) -> Threshold:
+    parts = _JOIN.split(text.strip())
+    example = "e.g. 'vg(function) > 15' or 'vg(function) > 10 and loc(function) > 60'"
+    groups: list[list[Condition]] = [[]]
+    units = set()
+    for index, part in enumerate(parts):
+        if index % 2:  # a joining word
+            if part == "or":
+                groups.append([])
+            continue
+        match = _CONDITION.match(part)
+        if not match:
+            raise ThresholdError(
+                f"threshold {text!r}: {part!r} is not FIELD(UNIT) OP NUMBER, {example}"
+            )
+        field, unit = match["field"], match["unit"]
+        if unit not in FIELDS:
+            known = ", ".join(FIELDS)
+            raise ThresholdError(f"threshold {text!r}: unknown unit {unit!r} (known: {known})")
+        if field not in FIELDS[unit]:
+            known = ", ".join(FIELDS[unit])
+            raise ThresholdError(f"threshold {text!r}: a {unit} has no {field!r} (it has: {known})")
+        units.add(unit)
+        groups[-1].append(Condition(field, match["op"], float(match["number"])))
+    if len(units) != 1:
+        raise ThresholdError(
+            f"threshold {text!r}: conditions joined by and/or must name one unit, not "
+            + " and ".join(sorted(units))
+        )
+    return Threshold(text.strip(), units.pop(), tuple(tuple(g) for g in groups))
+
+
+@dataclass(frozen=True, slots=True)
+class Unit:
+    """One function, file, element or the total: what names it, where it is, its numbers."""
+
+    name: str
+    path: str | None
+    line: int | None
+    values: Mapping[str, int]
+
+
+@dataclass(frozen=True, slots=True)
+class ThresholdFailure:
+    threshold: Threshold
+    unit: Unit
+
+    def __str__(self) -> str:
+        unit = self.unit
+        where = f"{unit.path}:{unit.line} " if unit.path and unit.line else ""
+        if unit.path and unit.name == unit.path:
+            where = ""  # a file or a one-file element: its name is its path
+        numbers = ", ".join(f"{f} = {unit.values[f]}" for f in self.threshold.fields)
+        return f"gate failed: {self.threshold.text}: {where}{unit.name} ({numbers})"
+
+
+def check_thresholds(
+    thresholds: Iterable[Threshold], units: Mapping[str, Sequence[Unit]]
+) -> tuple[ThresholdFailure, ...]:
+    """Every unit that fails a threshold, threshold by threshold, units in the order given
+    (``units``: the units of each kind)."""
+    return tuple(
+        ThresholdFailure(threshold, unit)
+        for threshold in thresholds
+        for unit in units.get(threshold.unit, ())
+        if threshold.fails(unit.values)
+    )
