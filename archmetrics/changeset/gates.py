@@ -1,31 +1,24 @@
 """Gates: conditions over the summary fields that fail a run (``--fail-on 'cost(new) > 20'``).
 
-A gate is ``FIELD(LOCATION) OP NUMBER`` or ``FIELD OP NUMBER`` (the total), where FIELD is a
-numeric summary field (cost, delta_s_e, scaled_changes ...), LOCATION is base, new, framework
-or total, and OP is one of > >= < <= == !=. A field that is undefined (null, with a note) never
-fails a gate: the note says why it has no value.
+A condition is ``FIELD(LOCATION) OP NUMBER`` or ``FIELD OP NUMBER`` (the total), where FIELD is
+a numeric summary field (cost, delta_s_e, scaled_changes ...), LOCATION is base, new,
+framework or total, and OP is one of > >= < <= == !=. A gate is one condition or several
+joined by ``and`` / ``or`` (``and`` binds tighter): ``cost(new) > 20 and changes(new) > 50``.
+A field that is undefined (null, with a note) makes its condition false, so it never fails a
+gate alone: the note says why it has no value.
 """
 
 from __future__ import annotations
 
-import operator
 import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from archmetrics.changeset.model import SUMMARY_FIELDS, Summary
+from archmetrics.complexity.thresholds import COMPARISON, OPERATORS, or_of_ands
 
-_OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
-    ">=": operator.ge,
-    "<=": operator.le,
-    "==": operator.eq,
-    "!=": operator.ne,
-    ">": operator.gt,
-    "<": operator.lt,
-}
-_GATE = re.compile(
-    r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*"
-    r"(?P<op>>=|<=|==|!=|>|<)\s*(?P<number>-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)\s*$"
+_CONDITION = re.compile(
+    r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*" + COMPARISON
 )
 NUMERIC_FIELDS = tuple(f for f in SUMMARY_FIELDS if f != "notes")
 LOCATIONS = ("base", "new", "framework", "total")
@@ -36,25 +29,53 @@ class GateError(ValueError):
 
 
 @dataclass(frozen=True, slots=True)
-class Gate:
-    text: str
+class Condition:
     field: str
     location: str
     op: str
     threshold: float
 
-    def holds(self, summaries: Mapping[str, Summary]) -> tuple[bool, float | None]:
-        """Whether the gate holds, and the value it read (None: undefined, so it holds)."""
+    @property
+    def name(self) -> str:
+        return f"{self.field}({self.location})"
+
+    def value(self, summaries: Mapping[str, Summary]) -> float | None:
         value = getattr(summaries[self.location], self.field)
-        if value is None:
-            return True, None
-        return not _OPERATORS[self.op](float(value), self.threshold), float(value)
+        return None if value is None else float(value)
+
+    def true(self, summaries: Mapping[str, Summary]) -> bool:
+        """Whether the comparison holds (an undefined value: it does not)."""
+        value = self.value(summaries)
+        return value is not None and OPERATORS[self.op](value, self.threshold)
+
+
+@dataclass(frozen=True, slots=True)
+class Gate:
+    """``text`` fails when all conditions of one of its ``groups`` are true."""
+
+    text: str
+    groups: tuple[tuple[Condition, ...], ...]
+
+    def failing(self, summaries: Mapping[str, Summary]) -> tuple[Condition, ...] | None:
+        """The conditions of the first group that fails, or None if the gate holds."""
+        for group in self.groups:
+            if all(c.true(summaries) for c in group):
+                return group
+        return None
 
 
 def parse_gate(text: str) -> Gate:
-    match = _GATE.match(text)
+    groups = or_of_ands(text)
+    return Gate(text.strip(), tuple(tuple(_condition(text, p) for p in g) for g in groups))
+
+
+def _condition(text: str, part: str) -> Condition:
+    match = _CONDITION.match(part)
     if not match:
-        raise GateError(f"gate {text!r}: expected FIELD(LOCATION) OP NUMBER, e.g. 'cost(new) > 20'")
+        raise GateError(
+            f"gate {text!r}: expected FIELD(LOCATION) OP NUMBER, e.g. 'cost(new) > 20'"
+            " (conditions may be joined by and / or)"
+        )
     field, location = match["field"], match["location"] or "total"
     if field not in NUMERIC_FIELDS:
         raise GateError(
@@ -64,24 +85,25 @@ def parse_gate(text: str) -> Gate:
         raise GateError(
             f"gate {text!r}: unknown location {location!r} (known: {', '.join(LOCATIONS)})"
         )
-    return Gate(text.strip(), field, location, match["op"], float(match["number"]))
+    return Condition(field, location, match["op"], float(match["number"]))
 
 
 @dataclass(frozen=True, slots=True)
 class GateFailure:
     gate: Gate
-    value: float
+    values: tuple[tuple[str, float], ...]  # each condition of the failing group: its value
 
     def __str__(self) -> str:
-        gate = self.gate
-        return f"gate failed: {gate.text} ({gate.field}({gate.location}) = {self.value:g})"
+        read = ", ".join(f"{name} = {value:g}" for name, value in self.values)
+        return f"gate failed: {self.gate.text} ({read})"
 
 
 def check_gates(gates: Iterable[Gate], summaries: Mapping[str, Summary]) -> tuple[GateFailure, ...]:
     """The gates that fail on these summaries (keys: base, new, framework, total)."""
     failures = []
     for gate in gates:
-        held, value = gate.holds(summaries)
-        if not held and value is not None:
-            failures.append(GateFailure(gate, value))
+        group = gate.failing(summaries)
+        if group is not None:
+            values = tuple((c.name, c.value(summaries) or 0.0) for c in group)
+            failures.append(GateFailure(gate, values))
     return tuple(failures)

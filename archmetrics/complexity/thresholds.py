@@ -15,7 +15,7 @@ import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-_OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
+OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
     ">=": operator.ge,
     "<=": operator.le,
     "==": operator.eq,
@@ -23,11 +23,23 @@ _OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
     ">": operator.gt,
     "<": operator.lt,
 }
-_CONDITION = re.compile(
-    r"^\s*(?P<field>[a-z_]+)\s*\(\s*(?P<unit>[a-z]+)\s*\)\s*"
-    r"(?P<op>>=|<=|==|!=|>|<)\s*(?P<number>-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)\s*$"
-)
+COMPARISON = r"(?P<op>>=|<=|==|!=|>|<)\s*(?P<number>-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)\s*$"
+"""An operator and a number, ending a condition (the gates of a diff read the same)."""
+_CONDITION = re.compile(r"^\s*(?P<field>[a-z_]+)\s*\(\s*(?P<unit>[a-z]+)\s*\)\s*" + COMPARISON)
 _JOIN = re.compile(r"\s+(and|or)\s+")
+
+
+def or_of_ands(text: str) -> list[list[str]]:
+    """The conditions of ``text`` joined by ``and`` / ``or``, ``and`` binding tighter: the
+    groups (any of which fails), each a list of conditions (all of which must hold)."""
+    groups: list[list[str]] = [[]]
+    for index, part in enumerate(_JOIN.split(text.strip())):
+        if index % 2 == 0:
+            groups[-1].append(part)
+        elif part == "or":
+            groups.append([])
+    return groups
+
 
 FIELDS: Mapping[str, tuple[str, ...]] = {
     "function": ("vg", "loc"),
@@ -49,7 +61,7 @@ class Condition:
     limit: float
 
     def holds(self, values: Mapping[str, int]) -> bool:
-        return _OPERATORS[self.op](float(values[self.field]), self.limit)
+        return OPERATORS[self.op](float(values[self.field]), self.limit)
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,35 +81,33 @@ class Threshold:
 
 
 def parse_threshold(text: str) -> Threshold:
-    parts = _JOIN.split(text.strip())
     example = "e.g. 'vg(function) > 15' or 'vg(function) > 10 and loc(function) > 60'"
-    groups: list[list[Condition]] = [[]]
-    units = set()
-    for index, part in enumerate(parts):
-        if index % 2:  # a joining word
-            if part == "or":
-                groups.append([])
-            continue
-        match = _CONDITION.match(part)
-        if not match:
-            raise ThresholdError(
-                f"threshold {text!r}: {part!r} is not FIELD(UNIT) OP NUMBER, {example}"
-            )
-        field, unit = match["field"], match["unit"]
-        if unit not in FIELDS:
-            known = ", ".join(FIELDS)
-            raise ThresholdError(f"threshold {text!r}: unknown unit {unit!r} (known: {known})")
-        if field not in FIELDS[unit]:
-            known = ", ".join(FIELDS[unit])
-            raise ThresholdError(f"threshold {text!r}: a {unit} has no {field!r} (it has: {known})")
-        units.add(unit)
-        groups[-1].append(Condition(field, match["op"], float(match["number"])))
+    groups = [[_condition(text, part, example) for part in group] for group in or_of_ands(text)]
+    units = {unit for group in groups for unit, _ in group}
     if len(units) != 1:
         raise ThresholdError(
             f"threshold {text!r}: conditions joined by and/or must name one unit, not "
             + " and ".join(sorted(units))
         )
-    return Threshold(text.strip(), units.pop(), tuple(tuple(g) for g in groups))
+    conditions = tuple(tuple(condition for _, condition in group) for group in groups)
+    return Threshold(text.strip(), units.pop(), conditions)
+
+
+def _condition(text: str, part: str, example: str) -> tuple[str, Condition]:
+    """One condition's unit and the condition."""
+    match = _CONDITION.match(part)
+    if not match:
+        raise ThresholdError(
+            f"threshold {text!r}: {part!r} is not FIELD(UNIT) OP NUMBER, {example}"
+        )
+    field, unit = match["field"], match["unit"]
+    if unit not in FIELDS:
+        known = ", ".join(FIELDS)
+        raise ThresholdError(f"threshold {text!r}: unknown unit {unit!r} (known: {known})")
+    if field not in FIELDS[unit]:
+        known = ", ".join(FIELDS[unit])
+        raise ThresholdError(f"threshold {text!r}: a {unit} has no {field!r} (it has: {known})")
+    return unit, Condition(field, match["op"], float(match["number"]))
 
 
 @dataclass(frozen=True, slots=True)

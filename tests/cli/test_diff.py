@@ -234,6 +234,31 @@ def test_gates(integration: GitRepo, capsys: pytest.CaptureFixture[str]) -> None
     assert main(["diff", "-C", str(integration.root), *args, "--fail-on", "cost(new) > 2"]) == 0
 
 
+def test_gates_combine_conditions_with_and_and_or(
+    integration: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # `and` binds tighter than `or`; a failure names the values of the group that failed
+    command = ["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2"]
+    command += ["--new", "wdb/**", "--format", "json"]
+    document = diff(integration, capsys, *command[3:])
+    cost = document["locations"]["new"]["cost"]
+    changes = document["locations"]["total"]["changes"]
+    assert cost > 1 and changes > 3
+    both = "cost(new) > 1 and changes > 3"
+    assert main([*command, "--fail-on", both]) == 1
+    err = capsys.readouterr().err
+    assert err.strip() == (
+        f"archmetrics: gate failed: {both} (cost(new) = {cost:g}, changes(total) = {changes:g})"
+    )
+    assert main([*command, "--fail-on", "cost(new) > 1 and changes > 1000"]) == 0
+    capsys.readouterr()
+    either = "changes > 1000 or delta_s_e(base) > 50 or cost(new) > 1 and added > 0"
+    assert main([*command, "--fail-on", either]) == 1
+    assert "gate failed" in capsys.readouterr().err
+    assert main([*command, "--fail-on", "cost(new) > 1 and"]) == 2
+    assert "expected FIELD(LOCATION) OP NUMBER" in capsys.readouterr().err
+
+
 def test_gates_from_config(integration: GitRepo, capsys: pytest.CaptureFixture[str]) -> None:
     integration.write(
         {"archmetrics.toml": 'gates = ["changes > 3"]\n[locations]\nnew = ["wdb/**"]\n'}
