@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -12,6 +13,7 @@ from typing import NoReturn
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
+from archmetrics.changeset.locations import BadPattern, compile_glob
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import LimitSettings, MacroSettings, Settings, load_settings
 from archmetrics.reports.formats import OutputFormat
@@ -83,8 +85,17 @@ def repo_root(path: Path) -> Path:
     return folder
 
 
-def settings_for(path: Path) -> Settings:
-    return load_settings(repo_root(path))
+def settings_for(path: Path, args: argparse.Namespace | None = None) -> Settings:
+    """The configuration of the repository (or folder) holding ``path``, with the command
+    line's ``--exclude`` globs after the configured ones (each checked now, exit 2 if bad)."""
+    settings = load_settings(repo_root(path))
+    extra = tuple(getattr(args, "exclude", None) or ())
+    for glob in extra:
+        try:
+            compile_glob(glob)
+        except BadPattern as error:
+            raise UsageError(f"--exclude: {error}") from None
+    return dataclasses.replace(settings, exclude=settings.exclude + extra) if extra else settings
 
 
 def emit(text: str, output: Path | None) -> None:

@@ -86,7 +86,7 @@ def scan_command(args: argparse.Namespace) -> int:
         if paths or args.rev:
             raise UsageError("--sample takes no PATH and no --rev")
         paths = (sample_path(),)
-    settings = settings_for(paths[0] if paths else Path.cwd())
+    settings = settings_for(paths[0] if paths else Path.cwd(), args)
     fmt = OutputFormat(args.format)
     request = ScanRequest(
         paths=paths,
@@ -108,7 +108,7 @@ def rules_command(args: argparse.Namespace) -> int:
     from archmetrics.reports.json_report import dumps
     from archmetrics.reports.table_report import rows_table, to_text
 
-    settings = settings_for(args.repo)
+    settings = settings_for(args.repo, args)
     ruleset = rule_set(settings, repo_root(args.repo))
     if args.format == "markdown":
         sys.stdout.write(rules_markdown(ruleset))
@@ -131,7 +131,7 @@ def graph_command(args: argparse.Namespace) -> int:
     from archmetrics.reports.graph import render
 
     paths: tuple[Path, ...] = tuple(args.paths)
-    settings = settings_for(paths[0] if paths else Path.cwd())
+    settings = settings_for(paths[0] if paths else Path.cwd(), args)
     request = ScanRequest(paths=paths, rev=args.rev, settings=settings, jobs=args.jobs)
     with facts_cache(args, settings) as cache:
         report = run_scan(request, NoProgress(), cache)
@@ -161,7 +161,7 @@ def diff_request(
         root=repo,
         base=base,
         head=head,
-        settings=settings_for(repo),
+        settings=settings_for(repo, args),
         new=tuple(args.new),
         framework=tuple(args.framework),
         gates=tuple(args.fail_on),

@@ -36,6 +36,18 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
     parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     parser.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     parser.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    add_exclude(parser)
+
+
+def add_exclude(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--exclude",
+        action="append",
+        default=[],
+        metavar="GLOB",
+        help="leave out the files this glob matches, after the configured `exclude` (repeatable;"
+        " each one excluded is listed in the report)",
+    )
 
 
 def _add_format(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
@@ -206,6 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    add_exclude(graph)
     cache = commands.add_parser("cache", help="the facts cache: where it is, how big; clear it")
     cache.add_argument("action", choices=["info", "clear"])
     cache.add_argument("--cache-path", type=Path, help="the facts cache file")

@@ -201,6 +201,36 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
     assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
 
 
+def test_exclude_on_the_command_line_adds_to_the_configured_globs(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    repo.commit(
+        "v1",
+        files={
+            "pyproject.toml": '[tool.archmetrics]\nexclude = ["vendor/**"]\n',
+            "src/p.py": PY_V2,
+            "src/gen/t.py": "x = 1\n",
+            "vendor/v.py": "x = 2\n",
+        },
+    )
+    base = ["scan", str(repo.root), "--format", "json", "-q", "--no-cache"]
+    document = _json(capsys, *base, "--exclude", "src/gen/**", "--exclude", "*.toml")
+    assert list(_files(document)) == ["src/p.py"]
+    assert document["excluded"] == [
+        {"path": "src/gen/t.py", "reason": "exclude:src/gen/**"},
+        {"path": "vendor/v.py", "reason": "exclude:vendor/**"},
+    ]
+    assert main([*base, "--exclude", "!vendor/**"]) == 2
+    assert "--exclude: unusable glob '!vendor/**'" in capsys.readouterr().err
+    # the same flag on a diff: the excluded file counts nowhere and is listed
+    repo.commit("v2", files={"src/gen/t.py": "x = 1\ny = 2\n", "src/p.py": PY_V2 + "z = 1\n"})
+    assert main(["diff", "-C", str(repo.root), "--base", "HEAD~1", "--head", "HEAD", "-q",
+                 "--format", "json", "--exclude", "src/gen/**"]) == 0  # fmt: skip
+    diffed = json.loads(capsys.readouterr().out)
+    assert [e["element"] for e in diffed["elements"] if e["status"] != "unchanged"] == ["src/p.py"]
+    assert {"path": "src/gen/t.py", "reason": "exclude:src/gen/**"} in diffed["excluded"]
+
+
 def test_a_plain_folder_scan_lists_the_folders_it_skipped(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
