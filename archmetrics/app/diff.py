@@ -13,7 +13,7 @@ from typing import TypeVar
 
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
-from archmetrics.app.progress import Progress
+from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.gates import Gate, check_gates, parse_gate
@@ -307,7 +307,11 @@ def _parse_side(
 def measure_change(
     request: DiffRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
-    """The change report between the two snapshots, and the parse warnings of both sides."""
+    """The change report between the two snapshots, and the parse warnings of both sides.
+    Every step is named on ``progress``: reading each side, parsing, coupling each tree,
+    comparing the files."""
+    progress = progress or NoProgress()
+    progress.phase(f"reading {request.base} and {request.head}")
     repo = git.open_repository(request.root)
     root = git.toplevel(repo)
     base = open_snapshot(root, request.base)
@@ -316,18 +320,25 @@ def measure_change(
     pre_blobs: dict[str, str] = {}
     post_blobs: dict[str, str] = {}
     pre = _parse_side(base, request, progress, cache, pre_blobs)
+    progress.phase(f"reading {request.head}")
     post = _parse_side(head, request, progress, cache, post_blobs)
     options, packs = coupling_options(request.settings), rule_set(request.settings, root)
+    progress.phase(f"coupling {request.base}")
+    pre_coupling = coupling_values(pre, rules, options, packs, cache, pre_blobs)
+    progress.phase(f"coupling {request.head}")
+    post_coupling = coupling_values(post, rules, options, packs, cache, post_blobs)
+    progress.phase("comparing the changed files")
     paths = {f.path for f in (*pre, *post)}
     change = compute_change(
         pair_files(pre, post, git.renames(repo, request.base, request.head)),
         group_elements(paths, options.per_file),
         rules,
-        coupling_values(pre, rules, options, packs, cache, pre_blobs),
-        coupling_values(post, rules, options, packs, cache, post_blobs),
+        pre_coupling,
+        post_coupling,
         dynamic_pre_zero=request.dynamic_pre_zero,
         diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
+    progress.stop()
     return change, _warnings(pre, post)
 
 

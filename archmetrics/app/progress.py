@@ -1,4 +1,8 @@
-"""The progress port: use cases report progress through it; the CLI decides how it looks."""
+"""The progress port: use cases report progress through it; the CLI decides how it looks.
+
+A long run has counted steps (``start``, ``advance``: parsing N files) and steps without a
+count (``phase``: listing a revision's files, coupling a tree, comparing statements, writing
+the report). Every long step is named, so the terminal never sits silent after a bar ends."""
 
 from __future__ import annotations
 
@@ -6,6 +10,9 @@ from typing import Protocol
 
 
 class Progress(Protocol):
+    def phase(self, description: str) -> None:
+        """A step without a count begins (it ends when the next step begins, or ``stop``)."""
+
     def start(self, description: str, total: int) -> None: ...
 
     def advance(self, count: int = 1) -> None: ...
@@ -15,6 +22,9 @@ class Progress(Protocol):
 
 class NoProgress:
     """Shows nothing (JSON output, tests, small runs)."""
+
+    def phase(self, description: str) -> None:
+        pass
 
     def start(self, description: str, total: int) -> None:
         pass

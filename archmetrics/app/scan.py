@@ -9,7 +9,7 @@ from pathlib import Path, PurePosixPath
 
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import measure
-from archmetrics.app.progress import Progress
+from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import ExcludedFile
 from archmetrics.complexity import file_metrics, totals
@@ -96,6 +96,8 @@ def run_scan(
     """Facts and metrics for every source file under the requested paths, and every unit
     that fails one of the request's thresholds."""
     thresholds = tuple(parse_threshold(g) for g in request.gates)  # bad ones before any work
+    progress = progress or NoProgress()
+    progress.phase("listing the files")
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
@@ -119,14 +121,17 @@ def run_scan(
     jobs = request.jobs or request.settings.jobs
     limits = worker_limits(request.settings.limits, request.settings.macros)
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
+    progress.phase("coupling")
     metrics = tuple(file_metrics(f) for f in facts)
+    coupling = measure(facts, request.settings, root)
+    progress.stop()
     report = ScanReport(
         root=str(root),
         revision=snapshot.label,
         facts=facts,
         files=metrics,
         totals=totals(metrics),
-        coupling=measure(facts, request.settings, root),
+        coupling=coupling,
         excluded=tuple(excluded),
         gates=tuple(t.text for t in thresholds),
     )

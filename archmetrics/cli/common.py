@@ -9,7 +9,7 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
@@ -39,17 +39,26 @@ class RichProgress:
         from rich.console import Console
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
+        self._console = Console(stderr=True)
         self._bar = Progress(
             "[progress.description]{task.description}",
             BarColumn(),
             MofNCompleteColumn(),
             TimeRemainingColumn(),
-            console=Console(stderr=True),
+            console=self._console,
             transient=True,
         )
         self._task: object = None
+        self._status: Any = None  # a rich Status: the spinner of a step without a count
+
+    def phase(self, description: str) -> None:
+        """A spinner and the step's name, until the next step."""
+        self.stop()
+        self._status = self._console.status(f"{description} ...")
+        self._status.start()
 
     def start(self, description: str, total: int) -> None:
+        self.stop()
         if total >= 20:
             self._bar.start()
             self._task = self._bar.add_task(description, total=total)
@@ -59,6 +68,9 @@ class RichProgress:
             self._bar.advance(self._task, count)  # type: ignore[arg-type]
 
     def stop(self) -> None:
+        if self._status is not None:
+            self._status.stop()
+            self._status = None
         if self._task is not None:
             self._bar.stop()
             self._task = None
@@ -68,6 +80,16 @@ def progress_for(fmt: OutputFormat, quiet: bool) -> Progress:
     if quiet or fmt is not OutputFormat.TABLE or not sys.stderr.isatty():
         return NoProgress()
     return RichProgress()
+
+
+@contextmanager
+def shown_progress(fmt: OutputFormat, quiet: bool) -> Iterator[Progress]:
+    """The run's progress, its last step ended however the run ends (an error included)."""
+    progress = progress_for(fmt, quiet)
+    try:
+        yield progress
+    finally:
+        progress.stop()
 
 
 def sample_path() -> Path:

@@ -17,10 +17,10 @@ from archmetrics.cli.common import (
     emit,
     facts_cache,
     gate_status,
-    progress_for,
     repo_root,
     sample_path,
     settings_for,
+    shown_progress,
     split,
 )
 from archmetrics.reports.formats import (
@@ -96,9 +96,11 @@ def scan_command(args: argparse.Namespace) -> int:
         plain_directory=args.sample,
         gates=tuple(args.fail_on),
     )
-    with facts_cache(args, settings) as cache:
-        report = run_scan(request, progress_for(fmt, args.quiet), cache)
-    emit(render_scan(report, fmt, Grouping(args.by)), args.output)
+    with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
+        report = run_scan(request, progress, cache)
+        progress.phase("writing the report")
+        text = render_scan(report, fmt, Grouping(args.by))
+    emit(text, args.output)
     return gate_status(report.failures, args)
 
 
@@ -176,9 +178,11 @@ def series_command(args: argparse.Namespace) -> int:
     request = SeriesRequest(
         diff_request(args, args.repo), tuple(args.revisions), split(args.labels), args.root
     )
-    with facts_cache(args, request.diff.settings) as cache:
-        report = run_series(request, progress_for(fmt, args.quiet), cache)
-    emit(render_series(report, fmt, args.max_rows), args.output)
+    with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
+        report = run_series(request, p, cache)
+        p.phase("writing the report")
+        text = render_series(report, fmt, args.max_rows)
+    emit(text, args.output)
     write_chart(args, CompareReport(((resolve_path(Path(args.repo)).name, report),)))
     return gate_status(report.failures, args)
 
@@ -192,9 +196,12 @@ def compare_command(args: argparse.Namespace) -> int:
         revisions = split(args.revisions) or tags_in_order(path)
         request = SeriesRequest(diff_request(args, path), revisions, split(args.labels), args.root)
         named.append((name, request))
-    with facts_cache(args, named[0][1].diff.settings) as cache:
-        report = run_compare(named, progress_for(fmt, args.quiet), cache)
-    emit(render_compare(report, fmt), args.output)
+    settings = named[0][1].diff.settings
+    with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as p:
+        report = run_compare(named, p, cache)
+        p.phase("writing the report")
+        text = render_compare(report, fmt)
+    emit(text, args.output)
     write_chart(args, report)
     return gate_status(report.failures, args)
 
@@ -205,9 +212,11 @@ def diff_command(args: argparse.Namespace) -> int:
     base, head = revisions_to_compare(args)
     request = diff_request(args, args.repo, base, head)
     settings = request.settings
-    with facts_cache(args, settings) as cache:
-        report = run_diff(request, progress_for(fmt, args.quiet), cache)
-    emit(render_diff(report, fmt, args.max_rows), args.output)
+    with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
+        report = run_diff(request, progress, cache)
+        progress.phase("writing the report")
+        text = render_diff(report, fmt, args.max_rows)
+    emit(text, args.output)
     stage = Stage(f"{base}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))

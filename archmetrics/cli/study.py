@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from archmetrics.cli.common import EXIT_OK, UsageError, facts_cache, progress_for
+from archmetrics.cli.common import EXIT_OK, UsageError, facts_cache, shown_progress
 from archmetrics.config import Settings
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.study.report import StudyReport
@@ -17,8 +17,9 @@ def replicate_command(args: argparse.Namespace) -> int:
     from archmetrics.study.report import render_json, render_markdown
 
     request = ReplicateRequest(subjects_root(), tuple(args.subject), args.jobs, args.keep_repos)
-    with facts_cache(args, Settings()) as cache:
-        report = run_replicate(request, progress_for(OutputFormat.TABLE, args.quiet), cache)
+    shown = shown_progress(OutputFormat.TABLE, args.quiet)
+    with facts_cache(args, Settings()) as cache, shown as progress:
+        report = run_replicate(request, progress, cache)
     out: Path = args.out
     charts: dict[str, list[str]] = {}
     try:

@@ -9,7 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.cli import main
+from archmetrics.config import load_settings
 from tests.gitrepo import GitRepo
 
 CLIENT = 'import zmq\nimport shared\n\nsock = zmq.Context().socket(zmq.REQ)\nsock.connect("tcp://localhost:5555")\n'
@@ -267,3 +270,45 @@ def test_an_edited_worktree_finds_the_link_sites_of_the_edited_files_only(
     post = {e["element"]: e["post"] for e in json.loads(cached)["elements"]}
     assert post["src/server.py"]["d_a"] == 0  # the client still connects to 5555
     assert len(sites() - before) == 1  # the edited server's; the others were read back
+
+
+class _Steps:
+    """A progress port that records the steps it is told of."""
+
+    def __init__(self) -> None:
+        self.steps: list[str] = []
+
+    def phase(self, description: str) -> None:
+        self.steps.append(description)
+
+    def start(self, description: str, total: int) -> None:
+        self.steps.append(f"{description} {total}")
+
+    def advance(self, count: int = 1) -> None:
+        pass
+
+    def stop(self) -> None:
+        self.steps.append("stop")
+
+
+def test_every_long_step_of_a_diff_and_a_scan_is_named(history: GitRepo) -> None:
+    # not only parsing: reading each side, coupling each tree and comparing are named, so
+    # a long run never sits silent after the parsing bar ends (issue 16)
+    steps = _Steps()
+    request = DiffRequest(history.root, "v1", "v2", load_settings(history.root), jobs=1)
+    run_diff(request, steps, None)
+    assert steps.steps == [
+        "reading v1 and v2",
+        "parsing 2",
+        "stop",
+        "reading v2",
+        "parsing 3",
+        "stop",
+        "coupling v1",
+        "coupling v2",
+        "comparing the changed files",
+        "stop",
+    ]
+    steps = _Steps()
+    run_scan(ScanRequest((history.root,), None, load_settings(history.root), jobs=1), steps)
+    assert steps.steps == ["listing the files", "parsing 3", "stop", "coupling", "stop"]
