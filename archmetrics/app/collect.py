@@ -5,13 +5,15 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.workers import Parsed, Task, WorkerLimits, parse_in_workers
-from archmetrics.config import LimitSettings, MacroSettings
+from archmetrics.config import LimitSettings, MacroSettings, Settings
 from archmetrics.facts import FileFacts, ParseWarning, Severity
 from archmetrics.parsers import LanguageTable, ParseLimits
 from archmetrics.parsers.c_family_macros import MacroNames
+from archmetrics.parsers.limits import stack_bytes
 from archmetrics.sources import Snapshot, SourceFile, codec
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import blob_hash
@@ -165,3 +167,29 @@ def not_measured(path: str, language: str, why: str) -> FileFacts:
     """The facts of a file a worker could not read within its limits: none, and why."""
     warning = ParseWarning(path, 1, f"not measured: {why}", Severity.ERROR)
     return FileFacts(path=path, language=language, parsed=False, warnings=(warning,))
+
+
+def limits_salt(settings: Settings) -> str:
+    """The parser limits when they differ from the defaults (facts depend on them), the
+    stack the parsers may use (their depth limits shrink on a small one), and the C/C++
+    macros the configuration names."""
+    limits = settings.limits
+    parser = (limits.file_mb, limits.nesting, limits.parse_seconds)
+    defaults = LimitSettings()
+    changed = parser != (defaults.file_mb, defaults.nesting, defaults.parse_seconds)
+    stack = stack_bytes()
+    macros = settings.macros
+    listed = [repr((macros.attribute, macros.function))] if macros != MacroSettings() else []
+    return " ".join(
+        [
+            *(map(str, parser) if changed else []),
+            *([str(stack)] if stack < 8 << 20 else []),
+            *listed,
+        ]
+    )
+
+
+def open_cache(path: Path, settings: Settings) -> FactsCache:
+    """The facts cache at ``path`` for facts made under ``settings`` (their parser limits
+    and macros salt its fingerprint, :func:`limits_salt`)."""
+    return FactsCache(path, limits_salt(settings))

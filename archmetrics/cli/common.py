@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -11,11 +10,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
 
+from archmetrics.app import settings as app_settings
+from archmetrics.app.collect import open_cache
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.changeset.locations import BadPattern, compile_glob
+from archmetrics.changeset.locations import BadPattern
 from archmetrics.complexity.thresholds import ThresholdFailure
-from archmetrics.config import LimitSettings, MacroSettings, Settings, load_settings
+from archmetrics.config import Settings
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.printable import one_line
 from archmetrics.sources.cache import FactsCache, choose_path
@@ -97,27 +98,13 @@ def sample_path() -> Path:
     return Path(__file__).resolve().parent.parent / "data" / "sample"
 
 
-def repo_root(path: Path) -> Path:
-    """The top of the git repository holding ``path``, or its folder outside git."""
-    from archmetrics.sources import git
-
-    folder = path if path.is_dir() else path.parent
-    if git.is_repository(folder):
-        return git.toplevel(git.open_repository(folder))
-    return folder
-
-
 def settings_for(path: Path, args: argparse.Namespace | None = None) -> Settings:
     """The configuration of the repository (or folder) holding ``path``, with the command
     line's ``--exclude`` globs after the configured ones (each checked now, exit 2 if bad)."""
-    settings = load_settings(repo_root(path))
-    extra = tuple(getattr(args, "exclude", None) or ())
-    for glob in extra:
-        try:
-            compile_glob(glob)
-        except BadPattern as error:
-            raise UsageError(f"--exclude: {error}") from None
-    return dataclasses.replace(settings, exclude=settings.exclude + extra) if extra else settings
+    try:
+        return app_settings.settings_for(path, tuple(getattr(args, "exclude", None) or ()))
+    except BadPattern as error:
+        raise UsageError(f"--exclude: {error}") from None
 
 
 def emit(text: str, output: Path | None) -> None:
@@ -148,28 +135,6 @@ def cache_location(args: argparse.Namespace, settings: Settings) -> Path:
     return choose_path(getattr(args, "cache_path", None), settings.cache_path, settings.source)
 
 
-def limits_salt(settings: Settings) -> str:
-    """The parser limits when they differ from the defaults (facts depend on them), the
-    stack the parsers may use (their depth limits shrink on a small one), and the C/C++
-    macros the configuration names."""
-    from archmetrics.parsers.limits import stack_bytes
-
-    limits = settings.limits
-    parser = (limits.file_mb, limits.nesting, limits.parse_seconds)
-    defaults = LimitSettings()
-    changed = parser != (defaults.file_mb, defaults.nesting, defaults.parse_seconds)
-    stack = stack_bytes()
-    macros = settings.macros
-    listed = [repr((macros.attribute, macros.function))] if macros != MacroSettings() else []
-    return " ".join(
-        [
-            *(map(str, parser) if changed else []),
-            *([str(stack)] if stack < 8 << 20 else []),
-            *listed,
-        ]
-    )
-
-
 @contextmanager
 def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsCache | None]:
     """The cache the flags and settings ask for (none with --no-cache or cache = false).
@@ -179,7 +144,7 @@ def facts_cache(args: argparse.Namespace, settings: Settings) -> Iterator[FactsC
         yield None
         _detail(args, f"no facts cache; measured in {time.monotonic() - started:.2f} s")
         return
-    with FactsCache(cache_location(args, settings), limits_salt(settings)) as cache:
+    with open_cache(cache_location(args, settings), settings) as cache:
         for notice in cache.notices:
             warn(notice)
         shown = len(cache.notices)

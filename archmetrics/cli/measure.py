@@ -11,13 +11,13 @@ from archmetrics.app.diff import DiffRequest, run_diff
 from archmetrics.app.progress import NoProgress
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
+from archmetrics.app.settings import repo_root
 from archmetrics.cli.common import (
     EXIT_OK,
     UsageError,
     emit,
     facts_cache,
     gate_status,
-    repo_root,
     sample_path,
     settings_for,
     shown_progress,

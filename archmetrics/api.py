@@ -1,0 +1,160 @@
+"""archmetrics for notebooks: scans, diffs, series and comparisons as pandas DataFrames.
+
+Each function measures as the command of the same name does (the repository's configuration,
+the facts cache, the parser processes) and returns one row per function, file, element,
+link, location or stage: the rows and columns of the command's ``--format csv`` (both come
+from :mod:`archmetrics.reports.frames`), with numbers as numbers and a missing value where a
+cell does not apply. docs/api.md shows a notebook that plots E across stages.
+
+    >>> from archmetrics import api
+    >>> api.scan("src", by="function").sort_values("vg").tail()
+    >>> api.series("wdb-soa", ["baseline", "first", "second"]).query("location == 'new'")
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from archmetrics.app.collect import open_cache
+from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.scan import ScanRequest, run_scan
+from archmetrics.app.series import SeriesRequest, run_compare, run_series
+from archmetrics.app.settings import settings_for
+from archmetrics.config import Settings
+from archmetrics.reports.frames import (
+    SCAN_GROUPINGS,
+    Table,
+    diff_table,
+    scan_table,
+    trend_table,
+)
+from archmetrics.reports.model import CompareReport
+from archmetrics.sources import EMPTY, git
+from archmetrics.sources.cache import FactsCache, choose_path
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["compare", "diff", "scan", "series"]
+
+
+def scan(
+    path: str | Path = ".",
+    *,
+    rev: str | None = None,
+    by: str = "file",
+    exclude: Sequence[str] = (),
+    cache: bool = True,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """One row per file (``by="file"``), function, element or link of the files under
+    ``path`` (at git revision ``rev``, or as on disk), as ``archmetrics scan --by BY``."""
+    if by not in SCAN_GROUPINGS:
+        raise ValueError(f"by={by!r}: expected one of {', '.join(SCAN_GROUPINGS)}")
+    path = Path(path)
+    settings = settings_for(path, exclude)
+    with _cache(settings, cache) as facts:
+        report = run_scan(ScanRequest((path,), rev, settings, jobs), cache=facts)
+    return _frame(scan_table(report, by))
+
+
+def diff(
+    repo: str | Path = ".",
+    base: str = "HEAD",
+    head: str = "WORKTREE",
+    *,
+    new: Sequence[str] = (),
+    framework: Sequence[str] = (),
+    exclude: Sequence[str] = (),
+    cache: bool = True,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """The chapter-6 metrics of the change from ``base`` to ``head``, as ``archmetrics diff``:
+    a row per location and the total (``row == "location"``), then a row per element."""
+    request = _diff_request(Path(repo), new, framework, exclude, jobs, base, head)
+    with _cache(request.settings, cache) as facts:
+        report = run_diff(request, cache=facts)
+    return _frame(diff_table(report))
+
+
+def series(
+    repo: str | Path,
+    revisions: Sequence[str],
+    labels: Sequence[str] = (),
+    *,
+    root: str = EMPTY,
+    new: Sequence[str] = (),
+    framework: Sequence[str] = (),
+    exclude: Sequence[str] = (),
+    cache: bool = True,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """Each stage measured against the one before (the first against ``root``), as
+    ``archmetrics series``: a row per stage and location with the trend fields."""
+    request = SeriesRequest(
+        _diff_request(Path(repo), new, framework, exclude, jobs),
+        tuple(revisions),
+        tuple(labels),
+        root,
+    )
+    with _cache(request.diff.settings, cache) as facts:
+        report = run_series(request, cache=facts)
+    return _frame(trend_table(CompareReport((("", report),))))
+
+
+def compare(
+    repos: Mapping[str, str | Path],
+    revisions: Sequence[str] = (),
+    labels: Sequence[str] = (),
+    *,
+    root: str = EMPTY,
+    new: Sequence[str] = (),
+    framework: Sequence[str] = (),
+    cache: bool = True,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """The same series for several repositories side by side, as ``archmetrics compare``:
+    a row per approach (the name given), stage and location. Without ``revisions``, each
+    repository's tags in history order."""
+    named = []
+    for name, path in repos.items():
+        stages = tuple(revisions) or git.tags_in_order(Path(path))
+        request = _diff_request(Path(path), new, framework, (), jobs)
+        named.append((name, SeriesRequest(request, stages, tuple(labels), root)))
+    if not named:
+        raise ValueError("compare needs at least one repository")
+    with _cache(named[0][1].diff.settings, cache) as facts:
+        report = run_compare(named, cache=facts)
+    return _frame(trend_table(report))
+
+
+def _frame(table: Table) -> pd.DataFrame:
+    import pandas as pd  # 0.3 s to import: only when a frame is asked for
+
+    return pd.DataFrame.from_records(table.rows, columns=list(table.columns))
+
+
+def _diff_request(
+    repo: Path,
+    new: Sequence[str],
+    framework: Sequence[str],
+    exclude: Sequence[str],
+    jobs: int,
+    base: str = "",
+    head: str = "",
+) -> DiffRequest:
+    settings = settings_for(repo, exclude)
+    return DiffRequest(repo, base, head, settings, tuple(new), tuple(framework), jobs=jobs)
+
+
+@contextmanager
+def _cache(settings: Settings, use: bool) -> Iterator[FactsCache | None]:
+    """The facts cache the configuration names (the command's default), or none."""
+    if not (use and settings.cache):
+        yield None
+        return
+    with open_cache(choose_path(None, settings.cache_path, settings.source), settings) as facts:
+        yield facts

@@ -1,0 +1,33 @@
+"""The configuration a measurement runs under: the repository's (or folder's) settings, with
+what the caller adds (``exclude`` globs), merged once for the command line and the API."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from pathlib import Path
+
+from archmetrics.changeset.locations import compile_glob
+from archmetrics.config import Settings, load_settings
+
+
+def repo_root(path: Path) -> Path:
+    """The top of the git repository holding ``path``, or its folder outside git."""
+    from archmetrics.sources import git
+
+    folder = path if path.is_dir() else path.parent
+    if git.is_repository(folder):
+        return git.toplevel(git.open_repository(folder))
+    return folder
+
+
+def settings_for(path: Path, exclude: Sequence[str] = ()) -> Settings:
+    """The settings of the repository or folder holding ``path``, with ``exclude`` after the
+    configured globs (each checked now: :class:`~archmetrics.changeset.locations.BadPattern`
+    names a bad one)."""
+    settings = load_settings(repo_root(path))
+    for glob in exclude:
+        compile_glob(glob)
+    if not exclude:
+        return settings
+    return dataclasses.replace(settings, exclude=settings.exclude + tuple(exclude))
