@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import io
 import shutil
+from collections.abc import Sequence
+from typing import Literal
 
 from rich.console import Console
 from rich.table import Table
@@ -22,7 +24,7 @@ from archmetrics.reports.printable import shown_warnings
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
     """Render rich objects to a string (ANSI colours only when ``color``), as wide as the
     terminal, or 160 columns when there is none."""
-    width = width or max(100, shutil.get_terminal_size((160, 24)).columns)
+    width = width or terminal_width()
     out = io.StringIO()
     console = Console(file=out, force_terminal=color, width=width, no_color=not color)
     for item in renderables:
@@ -33,7 +35,7 @@ def to_text(*renderables: object, color: bool = False, width: int | None = None)
 def _file_table(report: ScanReport) -> Table:
     t = report.totals
     table = Table(title=f"archmetrics scan: {report.revision}", show_footer=True)
-    table.add_column("file", footer=f"total ({t.files} files)")
+    table.add_column("file", footer=f"total ({t.files} files)", overflow="fold")
     table.add_column("lang")
     table.add_column("λ", justify="right", footer=str(t.loc))
     table.add_column("SLOC", justify="right", footer=str(t.sloc))
@@ -50,8 +52,8 @@ def _file_table(report: ScanReport) -> Table:
 def _function_table(report: ScanReport) -> Table:
     t = report.totals
     table = Table(title=f"archmetrics scan by function: {report.revision}", show_footer=True)
-    table.add_column("file", footer="total")
-    table.add_column("function", footer=f"{t.functions} functions")
+    table.add_column("file", footer="total", overflow="fold")
+    table.add_column("function", footer=f"{t.functions} functions", overflow="fold")
     table.add_column("line", justify="right")
     table.add_column(
         "λ", justify="right", footer=str(sum(fn.loc for f in report.files for fn in f.functions))
@@ -63,13 +65,49 @@ def _function_table(report: ScanReport) -> Table:
     return table
 
 
-def rows_table(title: str, header: tuple[str, ...], rows: list[list[str]], left: int) -> Table:
+def rows_table(
+    title: str,
+    header: tuple[str, ...],
+    rows: list[list[str]],
+    left: int,
+    width: int | None = None,
+    least_useful: Sequence[str] = (),
+) -> Table:
+    """A table whose ``left`` first columns name a row and whose others hold numbers, fitted
+    to ``width`` (the terminal's): names wrap, never end in ``…``; numbers are never cut;
+    when the columns do not fit, the ``least_useful`` ones are left out first, then the
+    rightmost, and the caption says which (the JSON and CSV have them all)."""
+    width = width or terminal_width()
+    need = [max((len(row[i]) for row in rows), default=1) for i in range(len(header))]
+    for i in range(left):  # a name shows at least this much of itself before it wraps
+        need[i] = min(need[i], _NAME_WIDTH)
+    need = [max(n, len(name)) for n, name in zip(need, header, strict=True)]
+    order = [header.index(name) for name in least_useful if name in header]
+    order += [i for i in reversed(range(left, len(header))) if i not in order]
+    kept = set(range(len(header)))
+    for i in order:
+        if sum(need[k] + 3 for k in kept) + 1 <= width or len(kept) <= 2:
+            break
+        kept.discard(i)
+    columns = sorted(kept)
     table = Table(title=title)
-    for i, name in enumerate(header):
-        table.add_column(name, justify="left" if i < left else "right")
+    for i in columns:
+        justify: Literal["left", "right"] = "left" if i < left else "right"
+        table.add_column(header[i], justify=justify, overflow="fold", min_width=need[i])
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(row[i] for i in columns))
+    if len(columns) < len(header):
+        dropped = ", ".join(name for i, name in enumerate(header) if i not in kept)
+        table.caption = f"{dropped} left out at {width} columns (--format json has them)"
     return table
+
+
+_NAME_WIDTH = 24  # characters of a row's name shown on one line before it wraps
+
+
+def terminal_width() -> int:
+    """The terminal's columns (at least 60), or 160 when there is none."""
+    return max(60, shutil.get_terminal_size((160, 24)).columns)
 
 
 def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
@@ -78,7 +116,7 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     elif grouping == "element":
         rows = coupling_rows.element_rows(report)
         title = f"archmetrics scan by element: {report.revision}"
-        table = rows_table(title, coupling_rows.ELEMENT_HEADER, rows, 2)
+        table = rows_table(title, coupling_rows.ELEMENT_HEADER, rows, 2, None, ("files",))
     elif grouping == "link":
         rows = coupling_rows.link_rows(report.coupling)
         title = f"archmetrics scan, every link: {report.revision}"
@@ -113,12 +151,11 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
         summary.add_column(column, justify="right")
     for row in diff_rows.summary_rows(report):
         summary.add_row(*row)
-    detail = Table(title="elements")
-    for i, name in enumerate(diff_rows.ELEMENT_HEADER):
-        detail.add_column(name, justify="left" if i < 3 else "right")
-    for element in report.change.elements:
-        if element.status.value != "unchanged":
-            detail.add_row(*diff_rows.element_row(element))
+    changed = [
+        diff_rows.element_row(e) for e in report.change.elements if e.status.value != "unchanged"
+    ]
+    least_useful = ("d_e", "d_a", "s_e", "s_a", "location", "λ pre", "v_g pre")
+    detail = rows_table("elements", diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
     unchanged = sum(e.status.value == "unchanged" for e in report.change.elements)
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
     lines += [f"note {n}" for n in diff_rows.notes(report)]
