@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+from pathspec import GitIgnoreSpec
+
 from archmetrics.sources.paths import quote_path
 
 EMPTY = "EMPTY"  # the empty tree: a first integration stage has nothing before it
@@ -141,20 +143,73 @@ class DirectorySnapshot:
 
 def _walk_folder(root: Path, folder: Path, skipped: dict[str, str]) -> Iterator[str]:
     """The files under ``folder`` (relative to ``root``), in walk order, skipping the folders
-    no one measures (version control, virtual environments, caches); each skipped folder is
-    recorded in ``skipped`` with the reason."""
+    no one measures (version control, virtual environments, caches) and what the folder's
+    ``.gitignore`` files ignore, as git would; each skipped folder or file is recorded in
+    ``skipped`` with the reason."""
+    ignores = _Ignores(root)
     for current, dirs, names in os.walk(folder):
         rel = Path(current).relative_to(root)
         kept = []
         for name in sorted(dirs):
+            path = (rel / name).as_posix()
             reason = _skip_reason(Path(current) / name, name)
+            if reason is None and ignores.ignored(path, directory=True):
+                reason = ignores.reason
             if reason is None:
                 kept.append(name)
             else:
-                skipped[quote_path((rel / name).as_posix()) + "/"] = reason
+                skipped[quote_path(path) + "/"] = reason
         dirs[:] = kept
         for name in sorted(names):
-            yield (rel / name).as_posix()
+            path = (rel / name).as_posix()
+            if ignores.ignored(path, directory=False):
+                skipped[quote_path(path)] = ignores.reason
+            else:
+                yield path
+
+
+_GITIGNORE_BYTES = 1 << 20  # a .gitignore read, at most (the folder is not trusted)
+_GITIGNORE_LINES = 10_000
+
+
+class _Ignores:
+    """The ``.gitignore`` files of a plain folder, read as git reads them: each applies to
+    the paths below its own folder, a deeper file's decision wins over a shallower one's,
+    and within a file the last matching pattern wins (``!`` re-includes). Read with
+    pathspec's gitignore rules; a file too large, unreadable or with a pattern pathspec
+    refuses counts as absent."""
+
+    reason = "ignored by .gitignore"
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self._specs: dict[str, GitIgnoreSpec | None] = {}
+
+    def _spec(self, folder: str) -> GitIgnoreSpec | None:
+        if folder not in self._specs:
+            self._specs[folder] = _read_gitignore(self.root / folder / ".gitignore")
+        return self._specs[folder]
+
+    def ignored(self, path: str, directory: bool) -> bool:
+        parts = path.split("/")
+        decision: bool | None = None
+        for depth in range(len(parts)):
+            spec = self._spec("/".join(parts[:depth]))
+            if spec is not None:
+                below = "/".join(parts[depth:]) + ("/" if directory else "")
+                found = spec.check_file(below).include
+                decision = decision if found is None else found
+        return bool(decision)
+
+
+def _read_gitignore(path: Path) -> GitIgnoreSpec | None:
+    try:
+        if not path.is_file() or path.is_symlink() or path.stat().st_size > _GITIGNORE_BYTES:
+            return None
+        lines = path.read_text("utf-8", "surrogateescape").splitlines()[:_GITIGNORE_LINES]
+        return GitIgnoreSpec.from_lines(lines)
+    except (OSError, ValueError):
+        return None
 
 
 def _skip_reason(path: Path, name: str) -> str | None:

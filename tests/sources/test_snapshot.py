@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 from archmetrics.sources.snapshot import DirectorySnapshot
@@ -57,3 +58,39 @@ def test_a_folder_is_skipped_for_what_it_is_not_for_its_name(tmp_path: Path) -> 
         "pkg.egg-info/": "package metadata",
         "src/__pycache__/": "bytecode cache",
     }
+
+
+GITIGNORED = {
+    ".gitignore": "build/\n*.log\n!keep.log\n/top.py\ndocs/**/draft*\n",
+    "sub/.gitignore": "local.py\n!/top.py\n*.py\n!wanted.py\n",
+    "a.py": "", "top.py": "", "keep.log": "", "x.log": "", "sub/top.py": "", "sub/local.py": "",
+    "sub/wanted.py": "", "sub/deep/more.py": "", "sub/deep/note.txt": "", "build/gen.py": "",
+    "src/build/gen.c": "", "docs/a/draft1.md": "", "docs/a/final.md": "", "src/m.c": "",
+    "weird name [x].py": "", "src/.gitignore": "\\#literal.c\n", "src/#literal.c": "",
+}  # fmt: skip
+
+
+def test_a_plain_folder_ignores_what_git_would_ignore(tmp_path: Path) -> None:
+    # outside git, the folder's .gitignore files are read as git reads them (the deeper file
+    # wins, the last match wins, ! re-includes, a leading / anchors to its folder): the
+    # files a folder snapshot lists are the files git would list as untracked
+    for name, text in GITIGNORED.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    snapshot = DirectorySnapshot(tmp_path)
+    ours = {f.path for f in snapshot.files()}
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    listed = subprocess.run(
+        ["git", "-C", str(tmp_path), "ls-files", "--others", "--exclude-standard", "-z"],
+        capture_output=True, text=True, check=True,
+    ).stdout  # fmt: skip
+    assert ours == set(filter(None, listed.split("\0")))
+    assert snapshot.skipped["build/"] == "ignored by .gitignore"
+    assert snapshot.skipped["sub/local.py"] == "ignored by .gitignore"
+    assert "sub/wanted.py" in ours and "keep.log" in ours and "sub/top.py" not in ours
+
+
+def test_a_gitignore_too_large_or_unreadable_counts_as_absent(tmp_path: Path) -> None:
+    (tmp_path / "a.py").write_text("")
+    (tmp_path / ".gitignore").write_bytes(b"*.py\n" + b"#" * (1 << 20))
+    assert {f.path for f in DirectorySnapshot(tmp_path).files()} == {"a.py", ".gitignore"}
