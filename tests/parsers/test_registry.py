@@ -10,7 +10,12 @@ from hypothesis import strategies as st
 from archmetrics.parsers import LanguageTable
 
 TABLE = LanguageTable.default({"PYX": "python", ".h": ""})
-_PARTS = st.text(alphabet="ab.Cc/hpPyY é", max_size=12)
+# paths as git gives them: no empty, `.` or `..` part (PurePosixPath would drop a `.` part,
+# reading `C.C/.` as `C.C`; no path a snapshot lists has one)
+_PART = st.text(alphabet="ab.CchpPyY é", min_size=1, max_size=6).filter(
+    lambda part: part not in {".", ".."}
+)
+_PARTS = st.lists(_PART, min_size=1, max_size=3).map("/".join)
 
 
 def _by_suffix(path: str) -> str | None:
