@@ -182,17 +182,21 @@ def test_the_graph_output_suffix_picks_its_format(tmp_path: Path, name: str, sta
     assert out.read_text().startswith(starts)
 
 
+def _excluding(repo: GitRepo, **more: str) -> None:
+    """A commit whose configuration excludes vendor/**, holding src/p.py, vendor/v.py (which
+    would warn if it were read) and ``more`` (path -> text)."""
+    files = {
+        "pyproject.toml": '[tool.archmetrics]\nexclude = ["vendor/**"]\n',
+        "src/p.py": PY_V2,
+        "vendor/v.py": "def broken(:\n",
+    }
+    repo.commit("v1", files={**files, **more})
+
+
 def test_the_configured_exclude_leaves_files_out_and_lists_them(
     repo: GitRepo, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    repo.commit(
-        "v1",
-        files={
-            "pyproject.toml": '[tool.archmetrics]\nexclude = ["vendor/**"]\n',
-            "src/p.py": PY_V2,
-            "vendor/v.py": "def broken(:\n",  # would warn if it were read
-        },
-    )
+    _excluding(repo)
     document = _json(capsys, "scan", str(repo.root), "--format", "json", "-q")
     assert list(_files(document)) == ["src/p.py"]
     assert document["excluded"] == [{"path": "vendor/v.py", "reason": "exclude:vendor/**"}]
@@ -204,15 +208,7 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
 def test_exclude_on_the_command_line_adds_to_the_configured_globs(
     repo: GitRepo, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    repo.commit(
-        "v1",
-        files={
-            "pyproject.toml": '[tool.archmetrics]\nexclude = ["vendor/**"]\n',
-            "src/p.py": PY_V2,
-            "src/gen/t.py": "x = 1\n",
-            "vendor/v.py": "x = 2\n",
-        },
-    )
+    _excluding(repo, **{"src/gen/t.py": "x = 1\n"})
     base = ["scan", str(repo.root), "--format", "json", "-q", "--no-cache"]
     document = _json(capsys, *base, "--exclude", "src/gen/**", "--exclude", "*.toml")
     assert list(_files(document)) == ["src/p.py"]
