@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 import textwrap
 import threading
+from dataclasses import dataclass
 from io import BytesIO
 from typing import TYPE_CHECKING, Any
 
@@ -91,11 +92,62 @@ def footnote(note: str) -> str:
     return f"{CONVENTION_NAMES.get(code.strip(), code.strip())}: {text.strip()}"
 
 
-def number(value: float) -> str:
-    """A bar label: integers plain, else one decimal from 10 up, two below."""
+def number(value: float, places: int | None = None) -> str:
+    """A bar label with ``places`` decimals (:func:`places`); without, integers plain, else one
+    decimal from 10 up, two below."""
+    if places is not None:
+        return f"{value:.{places}f}"
     if value.is_integer():
         return str(int(value))
     return f"{value:.1f}" if abs(value) >= 10 else f"{value:.2f}"
+
+
+def places(chart: Chart) -> int:
+    """One precision for every label of a chart: none when every value is a whole number
+    (counts), else two decimals below 10, one below 100, none above."""
+    numbers = _numbers(chart)
+    if all(n.is_integer() for n in numbers):
+        return 0
+    largest = max(abs(n) for n in numbers)
+    return 2 if largest < 10 else 1 if largest < 100 else 0
+
+
+@dataclass(frozen=True, slots=True)
+class _Labels:
+    """How a chart's value labels are written: its precision, and whether they stand upright
+    (horizontal when the widest fits over its bar, else turned a quarter)."""
+
+    places: int
+    rotation: int
+    notes: Footnotes
+
+    def text(self, value: Value) -> str:
+        """The value and its convention marks; n/a for none; a zero's marks only (no "0" on
+        an empty bar)."""
+        if value.number is None:
+            return "n/a"
+        if value.number == 0:
+            return self.notes.of(value)
+        return number(value.number, self.places) + self.notes.of(value)
+
+
+_LABEL_SIZE = 8  # points
+_CHAR_WIDTH = 0.6  # of the font size: a digit's width, about
+
+
+def _labels(chart: Chart, notes: Footnotes) -> _Labels:
+    decimals = places(chart)
+    probe = _Labels(decimals, 0, notes)
+    widest = max(
+        (len(probe.text(v)) for p in chart.panels for b in p.bars for v in b.values), default=0
+    )
+    cols = chart.shape[1]
+    panel_points = chart.size[0] * 72 * 0.75 / cols  # a panel's share of the figure's width
+    bar_points = min(
+        panel_points / max(len(p.groups), 1) * 0.8 / max(len(p.bars), 1) for p in chart.panels
+    )
+    fits = widest * _LABEL_SIZE * _CHAR_WIDTH <= bar_points
+    return _Labels(decimals, 0 if fits else 90, notes)
 
 
 def _numbers(chart: Chart) -> list[float]:
@@ -113,26 +165,28 @@ def _limits(chart: Chart) -> tuple[float, float]:
     return low - (room * span if low < 0 else 0.05 * span), high + room * span
 
 
-def _label(ax: Any, x: float, value: Value, notes: Footnotes) -> None:
-    """The value (or n/a) and its convention marks, rotated, just past the bar's end."""
+def _label(ax: Any, x: float, value: Value, labels: _Labels) -> None:
+    """The value (or n/a) and its convention marks just past the bar's end."""
     y = value.number if value.number is not None else 0.0
-    text = "n/a" if value.number is None else number(value.number) + notes.of(value)
+    text = labels.text(value)
+    if not text:
+        return
     below = y < 0
     ax.annotate(
         text,
         (x, y),
         xytext=(0, -2 if below else 2),
         textcoords="offset points",
-        rotation=90,
+        rotation=labels.rotation,
         ha="center",
         va="top" if below else "bottom",
-        fontsize=8,
+        fontsize=_LABEL_SIZE,
         color="0.35" if value.number is None else "0.1",
         style="italic" if value.number is None else "normal",
     )
 
 
-def _panel(ax: Any, panel: Panel, notes: Footnotes) -> None:
+def _panel(ax: Any, panel: Panel, labels: _Labels) -> None:
     width = 0.8 / max(len(panel.bars), 1)
     for i, bars in enumerate(panel.bars):
         offset = (i - (len(panel.bars) - 1) / 2) * width
@@ -144,7 +198,7 @@ def _panel(ax: Any, panel: Panel, notes: Footnotes) -> None:
             at, heights = zip(*drawn, strict=True)
             ax.bar(at, heights, width, color=bars.colour, edgecolor="0.15", linewidth=0.5)
         for x, value in zip(xs, bars.values, strict=True):
-            _label(ax, x, value, notes)
+            _label(ax, x, value, labels)
     ax.set_xticks(range(len(panel.groups)), panel.groups, fontsize=10)
     ax.set_xlim(-0.5, len(panel.groups) - 0.5)
     ax.axhline(0, color="0.15", linewidth=0.8)
@@ -161,8 +215,11 @@ def _axes(fig: Figure, chart: Chart, notes: Footnotes) -> None:
     """The panel grid on one shared y axis; x labels on the bottom row only."""
     rows, cols = chart.shape
     axes = list(fig.subplots(rows, cols, sharey=True, squeeze=False).flat)
+    labels = _labels(chart, notes)
     for ax, panel in zip(axes, chart.panels, strict=False):
-        _panel(ax, panel, notes)
+        _panel(ax, panel, labels)
+        if len(chart.panels) == 1:
+            ax.set_title("")  # the one repository is named in the chart's title already
     for ax in axes[len(chart.panels) :]:
         ax.set_visible(False)
     for ax in axes[(rows - 1) * cols :]:

@@ -24,6 +24,7 @@ from archmetrics.reports.charts import (
     series_name,
 )
 from archmetrics.reports.charts_data import LOCATIONS
+from archmetrics.reports.charts_draw import _figure
 from archmetrics.reports.charts_layout import APPROACH_COLOURS, LOCATION_COLOURS
 from archmetrics.reports.model import CompareReport, SeriesReport
 from tests.reports.study_repos import (
@@ -263,3 +264,31 @@ def test_names_are_shown_as_typed_not_as_mathtext(study: CompareReport) -> None:
     assert texts[-2:] == ["cost $x$ 1", "$"]  # the legend: escaped, so drawn literally
     assert "Complexity change cost across stages: cost $x$ 1, $" in texts
     assert decode_png(render_compare_chart(renamed, "scaled_changes")) is not None
+
+
+def _value_labels(study: CompareReport, kind: str) -> list[tuple[str, float]]:
+    """Each value label's text and rotation, as drawn."""
+    figure = _figure(chart_of(study, kind))
+    return [(t.get_text(), t.get_rotation()) for ax in figure.axes for t in ax.texts]
+
+
+def test_value_labels_share_one_precision_and_an_empty_bar_shows_no_zero(
+    study: CompareReport,
+) -> None:
+    labels = [text for text, _ in _value_labels(study, "cost")]
+    numbers = [text.rstrip("†‡§*¶") for text in labels if text and text != "n/a"]
+    decimals = {len(n.split(".")[1]) if "." in n else 0 for n in numbers if n}
+    assert len(decimals) == 1 and decimals != {0}  # E: 2.00 beside 4.24, not 2 beside 4.24
+    assert not any(text.rstrip("†‡§*¶") in {"0", "0.0", "0.00"} for text in labels)
+    counts = [text.rstrip("†‡§*¶") for text, _ in _value_labels(study, "coupling")]
+    assert all("." not in n for n in counts if n and n != "n/a")  # counts stay whole
+
+
+def test_value_labels_stand_upright_where_they_fit(study: CompareReport) -> None:
+    crowded = {rotation for _, rotation in _value_labels(study, "cost")}
+    alone = CompareReport(((series_name(study.series[0][1]), study.series[0][1]),))
+    roomy = _figure(chart_of(alone, "cost_total"))
+    upright = {t.get_rotation() for ax in roomy.axes for t in ax.texts}
+    assert crowded == {90.0}  # nine bars a panel: turned a quarter, as before
+    assert upright == {0.0}
+    assert [ax.get_title() for ax in roomy.axes if ax.get_visible()] == [""]  # named once
