@@ -116,6 +116,21 @@ def stage_labels(report: CompareReport) -> tuple[str, ...]:
     return tuple(seen)
 
 
+def stage_revisions(report: CompareReport, stages: tuple[str, ...]) -> tuple[str | None, ...]:
+    """The revision each stage measured (its head), where every series that has the stage
+    measured the same one and it is not the stage's label already; else None."""
+    heads: dict[str, set[str]] = {}
+    for _, series in report.series:
+        for stage in series.stages:
+            heads.setdefault(stage.label, set()).add(stage.report.head)
+    found: list[str | None] = []
+    for label in stages:
+        revisions = heads.get(label, set())
+        only = next(iter(revisions)) if len(revisions) == 1 else None
+        found.append(only if only != label else None)
+    return tuple(found)
+
+
 def summary_at(series: SeriesReport, stage: str, location: str) -> Summary | None:
     """S(location) of the named stage, or None when the series has no such stage."""
     for s in series.stages:

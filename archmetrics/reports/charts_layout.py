@@ -14,7 +14,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from archmetrics.reports.charts_data import LOCATIONS, Measure, Value, stage_labels, stage_value
+from archmetrics.reports.charts_data import (
+    LOCATIONS,
+    Measure,
+    Value,
+    stage_labels,
+    stage_revisions,
+    stage_value,
+)
 from archmetrics.reports.model import CompareReport
 
 # Okabe & Ito's colour-blind-safe palette
@@ -64,6 +71,15 @@ def literal(text: str) -> str:
     return text.replace("$", r"\$")
 
 
+def stage_ticks(report: CompareReport, stages: tuple[str, ...]) -> tuple[str, ...]:
+    """Each stage's label, and under it the revision it measured when that says more
+    (``first`` over ``v1.2``; a stage named by its revision once)."""
+    return tuple(
+        literal(st) if revision is None else f"{literal(st)}\n({literal(revision)})"
+        for st, revision in zip(stages, stage_revisions(report, stages), strict=True)
+    )
+
+
 def approaches_of(report: CompareReport) -> str:
     return ", ".join(literal(name) for name, _ in report.series)
 
@@ -74,7 +90,7 @@ def by_location(report: CompareReport, measure: Measure) -> Chart:
     panels = tuple(
         Panel(
             literal(name),
-            tuple(literal(st) for st in stages),
+            stage_ticks(report, stages),
             tuple(
                 Bars(
                     loc,
@@ -135,7 +151,7 @@ def totals(report: CompareReport, measures: tuple[Measure, ...], title: str) -> 
     panels = tuple(
         Panel(
             f"{m.total}  {m.name}" if len(measures) > 1 else "",
-            tuple(literal(st) for st in stages),
+            stage_ticks(report, stages),
             tuple(
                 Bars(
                     literal(name),

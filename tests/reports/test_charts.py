@@ -26,7 +26,7 @@ from archmetrics.reports.charts import (
 from archmetrics.reports.charts_data import LOCATIONS
 from archmetrics.reports.charts_draw import _figure
 from archmetrics.reports.charts_layout import APPROACH_COLOURS, LOCATION_COLOURS
-from archmetrics.reports.model import CompareReport, SeriesReport
+from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from tests.reports.study_repos import (
     APPROACHES,
     STAGES,
@@ -292,3 +292,17 @@ def test_value_labels_stand_upright_where_they_fit(study: CompareReport) -> None
     assert crowded == {90.0}  # nine bars a panel: turned a quarter, as before
     assert upright == {0.0}
     assert [ax.get_title() for ax in roomy.axes if ax.get_visible()] == [""]  # named once
+
+
+def test_stages_named_otherwise_show_the_revision_they_measured(study: CompareReport) -> None:
+    # `series v1 v2 --labels one,two`: the x axis says both, the label over its revision
+    name, series = study.series[0]
+    renamed = SeriesReport(
+        series.repo,
+        tuple(Stage(f"stage {i}", s.report) for i, s in enumerate(series.stages)),
+    )
+    chart = chart_of(CompareReport(((name, renamed),)), "cost")
+    heads = [s.report.head for s in series.stages]
+    assert chart.panels[0].groups == tuple(f"stage {i}\n({head})" for i, head in enumerate(heads))
+    # stages named by their revisions (the study's tags) say it once
+    assert chart_of(study, "cost").panels[0].groups == tuple(heads)
