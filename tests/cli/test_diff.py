@@ -205,6 +205,11 @@ def test_index_and_worktree(repo: GitRepo, capsys: pytest.CaptureFixture[str]) -
     assert staged["added"] == 4
     working = diff(repo, capsys, "--base", "HEAD", "--head", "WORKTREE")["locations"]["total"]
     assert working["added"] == 5
+    # WORKTREE and INDEX work as a base too: the same change, read backwards
+    back = diff(repo, capsys, "--base", "WORKTREE", "--head", "HEAD")["locations"]["total"]
+    assert (back["added"], back["removed"]) == (0, 5)
+    unstaged = diff(repo, capsys, "--base", "INDEX", "--head", "WORKTREE")["locations"]["total"]
+    assert unstaged["added"] == 1  # c.py only
     assert repo.status() == before  # it only reads
 
 
