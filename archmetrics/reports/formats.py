@@ -5,7 +5,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from enum import StrEnum
 
-from archmetrics.reports import csv_report, json_report, markdown_report, table_report
+from archmetrics.reports import (
+    codeclimate_report,
+    csv_report,
+    json_report,
+    markdown_report,
+    table_report,
+)
 from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
 from archmetrics.reports.printable import printable
 
@@ -15,6 +21,7 @@ class OutputFormat(StrEnum):
     JSON = "json"
     MARKDOWN = "markdown"
     CSV = "csv"
+    CODECLIMATE = "codeclimate"  # GitLab Code Quality: failed gates and thresholds as issues
 
 
 class Grouping(StrEnum):
@@ -33,14 +40,16 @@ _SCAN: dict[OutputFormat, ScanRenderer] = {
     OutputFormat.JSON: lambda report, grouping: json_report.render_scan(report),
     OutputFormat.MARKDOWN: markdown_report.render_scan,
     OutputFormat.CSV: csv_report.render_scan,
+    OutputFormat.CODECLIMATE: codeclimate_report.render_scan,
 }
 assert set(_SCAN) == set(OutputFormat), "every output format needs a scan renderer"
 
 
 def _safe(fmt: OutputFormat, text: str) -> str:
-    """JSON escapes control characters itself; every other format goes through
+    """JSON (and Code Climate's JSON, ASCII) escapes control characters itself; every other
+    format goes through
     :func:`~archmetrics.reports.printable.printable`."""
-    return text if fmt is OutputFormat.JSON else printable(text)
+    return text if fmt in (OutputFormat.JSON, OutputFormat.CODECLIMATE) else printable(text)
 
 
 def render_scan(report: ScanReport, fmt: OutputFormat, grouping: Grouping) -> str:
@@ -52,6 +61,7 @@ _DIFF: dict[OutputFormat, Callable[[DiffReport], str]] = {
     OutputFormat.JSON: json_report.render_diff,
     OutputFormat.MARKDOWN: markdown_report.render_diff,
     OutputFormat.CSV: csv_report.render_diff,
+    OutputFormat.CODECLIMATE: codeclimate_report.render_diff,
 }
 assert set(_DIFF) == set(OutputFormat), "every output format needs a diff renderer"
 
@@ -69,12 +79,14 @@ _SERIES: dict[OutputFormat, Callable[[SeriesReport], str]] = {
     OutputFormat.JSON: json_report.render_series,
     OutputFormat.MARKDOWN: markdown_report.render_series,
     OutputFormat.CSV: csv_report.render_series,
+    OutputFormat.CODECLIMATE: codeclimate_report.render_series,
 }
 _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
     OutputFormat.TABLE: table_report.render_compare,
     OutputFormat.JSON: json_report.render_compare,
     OutputFormat.MARKDOWN: markdown_report.render_compare,
     OutputFormat.CSV: csv_report.render_compare,
+    OutputFormat.CODECLIMATE: codeclimate_report.render_compare,
 }
 assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs series/compare"
 
