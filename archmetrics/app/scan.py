@@ -14,6 +14,7 @@ from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import ExcludedFile
 from archmetrics.complexity import file_metrics, totals
 from archmetrics.complexity.thresholds import (
+    FIELDS,
     Threshold,
     Unit,
     check_thresholds,
@@ -21,6 +22,8 @@ from archmetrics.complexity.thresholds import (
 )
 from archmetrics.config import Settings
 from archmetrics.parsers import LanguageTable
+from archmetrics.reports.frames import scan_table
+from archmetrics.reports.json_report import totals_dict
 from archmetrics.reports.model import ScanReport
 from archmetrics.sources import SourceError, open_snapshot
 from archmetrics.sources.cache import FactsCache
@@ -143,30 +146,32 @@ def run_scan(
 
 def _units(report: ScanReport, thresholds: tuple[Threshold, ...]) -> dict[str, list[Unit]]:
     """The functions, files, elements and the total of ``report`` as threshold units (only
-    the kinds some threshold names)."""
-    wanted = {t.unit for t in thresholds}
+    the kinds some threshold names), their numbers read from the rows the CSV and the API
+    show (reports/frames.py)."""
     units: dict[str, list[Unit]] = {}
-    if "function" in wanted:
-        units["function"] = [
-            Unit(fn.qualified_name, f.path, fn.line, {"vg": fn.vg, "loc": fn.loc})
-            for f in report.files
-            for fn in f.functions
+    for kind in {t.unit for t in thresholds}:
+        if kind == "total":
+            numbers = totals_dict(report.totals)
+            units[kind] = [Unit("total", None, None, {f: numbers[f] for f in FIELDS[kind]})]
+            continue
+        table = scan_table(report, kind)
+        rows = [dict(zip(table.columns, row, strict=True)) for row in table.rows]
+        name, path, line = _WHERE[kind]
+        units[kind] = [
+            Unit(
+                str(row[name]),
+                str(row[path]) if path else None,
+                int(row[line]) if line else None,  # type: ignore[arg-type]
+                {f: int(row[f]) for f in FIELDS[kind]},  # type: ignore[arg-type]
+            )
+            for row in rows
         ]
-    if "file" in wanted:
-        units["file"] = [
-            Unit(f.path, f.path, None, {"vg": f.vg, "loc": f.loc, "sloc": f.sloc,
-                                        "functions": len(f.functions), "warnings": len(f.warnings)})
-            for f in report.files
-        ]  # fmt: skip
-    if "element" in wanted:
-        units["element"] = [
-            Unit(r.element, None, None, {"vg": r.vg, "loc": r.loc, "sloc": r.sloc, "s_a": r.s_a,
-                                         "s_e": r.s_e, "d_a": r.d_a, "d_e": r.d_e})
-            for r in report.element_rows()
-        ]  # fmt: skip
-    if "total" in wanted:
-        t = report.totals
-        numbers = {"files": t.files, "functions": t.functions, "loc": t.loc, "sloc": t.sloc,
-                   "vg": t.vg, "warnings": t.warnings, "unparsed": t.unparsed}  # fmt: skip
-        units["total"] = [Unit("total", None, None, numbers)]
     return units
+
+
+# a unit kind's columns (reports/frames.py) naming it, its file and its line
+_WHERE = {
+    "function": ("function", "path", "line"),
+    "file": ("path", "path", None),
+    "element": ("element", None, None),
+}

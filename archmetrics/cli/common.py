@@ -18,7 +18,8 @@ from archmetrics.changeset.locations import BadPattern
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import Settings
 from archmetrics.reports.formats import OutputFormat
-from archmetrics.reports.printable import one_line
+from archmetrics.reports.printable import one_line, shown_lines
+from archmetrics.reports.table_report import SHOWN_FAILURES
 from archmetrics.sources.cache import FactsCache, choose_path
 
 EXIT_OK, EXIT_GATE, EXIT_USAGE = 0, 1, 2
@@ -166,26 +167,18 @@ def _detail(args: argparse.Namespace, text: str) -> None:
         print(f"archmetrics: {one_line(text)}", file=sys.stderr)
 
 
-SHOWN_ON_STDERR = 50  # failures printed on stderr, at most (a report lists them all)
-
-
 def gate_status(
     failures: Sequence[GateFailure | ThresholdFailure], args: argparse.Namespace
 ) -> int:
     """Exit 1 if a gate failed, else 0. Each failure goes to stderr unless the report itself
     showed it on stdout (a table or Markdown, every report lists its failed gates): a
     failure is printed once, and a report written to a file or as data still names it;
-    past ``SHOWN_ON_STDERR`` failures (a threshold thousands of functions fail), a count."""
+    past the first ``SHOWN_FAILURES`` (a threshold thousands of functions fail), a count."""
     shown = args.output is None and args.format in (OutputFormat.TABLE, OutputFormat.MARKDOWN)
     if not shown:
-        for failure in failures[:SHOWN_ON_STDERR]:
-            print(f"archmetrics: {one_line(str(failure))}", file=sys.stderr)
-        if len(failures) > SHOWN_ON_STDERR:
-            more = len(failures) - SHOWN_ON_STDERR
-            print(
-                f"archmetrics: ... and {more} more failures (the report lists them)",
-                file=sys.stderr,
-            )
+        more = "... and {count} more failures (the report lists them)"
+        for line in shown_lines(failures, SHOWN_FAILURES, more):
+            print(f"archmetrics: {one_line(line)}", file=sys.stderr)
     return EXIT_GATE if failures else EXIT_OK
 
 

@@ -40,6 +40,8 @@ def _dump(issues: list[dict[str, Any]]) -> str:
 
 def render_scan(report: ScanReport, grouping: str = "file") -> str:
     """Every unit over a threshold, where it is."""
+    if not report.failures:
+        return _dump([])
     first_file = {r.element: r.files[0] for r in report.element_rows() if r.files}
     issues = []
     for failure in report.failures:

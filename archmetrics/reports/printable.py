@@ -39,10 +39,17 @@ SHOWN_WARNINGS = 20
 def shown_warnings(warnings: Sequence[object], limit: int = SHOWN_WARNINGS) -> list[str]:
     """The first ``limit`` warnings as text, then one line counting the rest and the files
     they are in (a warning's ``path``, when it has one)."""
-    shown = [str(warning) for warning in warnings[:limit]]
-    rest = warnings[limit:]
-    if rest:
-        files = {getattr(warning, "path", None) for warning in rest} - {None}
-        where = f" in {len(files)} files" if files else ""
-        shown.append(f"... and {len(rest)} more warnings{where} (--format json lists them all)")
-    return shown
+    files = {getattr(warning, "path", None) for warning in warnings[limit:]} - {None}
+    where = f" in {len(files)} files" if files else ""
+    return shown_lines(
+        warnings, limit, "... and {count} more warnings" + where + " (--format json lists them all)"
+    )
+
+
+def shown_lines(items: Sequence[object], limit: int, more: str) -> list[str]:
+    """The first ``limit`` items as text, then ``more`` (its ``{count}``: how many are left
+    out) when there are more: what a table, Markdown or stderr lists of a long list."""
+    lines = [str(item) for item in items[:limit]]
+    if len(items) > limit:
+        lines.append(more.format(count=len(items) - limit))
+    return lines

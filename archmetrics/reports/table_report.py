@@ -18,7 +18,7 @@ from archmetrics.reports.model import (
     ScanReport,
     SeriesReport,
 )
-from archmetrics.reports.printable import shown_warnings
+from archmetrics.reports.printable import shown_lines, shown_warnings
 
 
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
@@ -135,11 +135,8 @@ SHOWN_FAILURES = 50  # failed units listed in a table, Markdown or on stderr; JS
 
 def gate_lines(report: ScanReport) -> list[str]:
     """The scan's failed thresholds, one line per failing unit, at most ``SHOWN_FAILURES``."""
-    lines = [str(f) for f in report.failures[:SHOWN_FAILURES]]
-    if len(report.failures) > SHOWN_FAILURES:
-        more = len(report.failures) - SHOWN_FAILURES
-        lines.append(f"... and {more} more failing units (--format json lists them all)")
-    return lines
+    more = "... and {count} more failing units (--format json lists them all)"
+    return shown_lines(report.failures, SHOWN_FAILURES, more)
 
 
 def render_diff(report: DiffReport, color: bool = False) -> str:
