@@ -32,8 +32,9 @@ from archmetrics.reports.frames import (
     trend_table,
 )
 from archmetrics.reports.model import CompareReport
-from archmetrics.sources import EMPTY, git
+from archmetrics.sources import EMPTY
 from archmetrics.sources.cache import FactsCache, choose_path
+from archmetrics.sources.checkout import open_checkout
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -121,7 +122,7 @@ def compare(
     repository's tags in history order."""
     named = []
     for name, path in repos.items():
-        stages = tuple(revisions) or git.tags_in_order(Path(path))
+        stages = tuple(revisions) or open_checkout(Path(path)).tags()
         request = _diff_request(Path(path), new, framework, (), jobs)
         named.append((name, SeriesRequest(request, stages, tuple(labels), root)))
     if not named:

@@ -14,8 +14,10 @@ from typing import TypeVar
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.progress import NoProgress, Progress
-from archmetrics.changeset import ChangeReport, Coupling, FilePair, LocationRules, compute_change
+from archmetrics.app.workers import WorkerLimits
+from archmetrics.changeset import ChangeReport, Coupling, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
+from archmetrics.changeset.files import measured_files, pair_files
 from archmetrics.changeset.gates import Gate, check_gates, parse_gate
 from archmetrics.changeset.statement_diff import (
     CHANGE_RECORD,
@@ -32,8 +34,9 @@ from archmetrics.coupling.sitememo import RECORD, SiteMemo
 from archmetrics.facts import FileFacts, ParseWarning
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import DiffReport
-from archmetrics.sources import Snapshot, git, open_snapshot
+from archmetrics.sources import Snapshot
 from archmetrics.sources.cache import FactsCache, code_fingerprint
+from archmetrics.sources.checkout import Checkout, open_checkout
 
 
 @functools.cache
@@ -54,6 +57,39 @@ class DiffRequest:
     gates: tuple[str, ...] = ()  # --fail-on, after the configured ones
     jobs: int = 0
     dynamic_pre_zero: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class DiffOptions:
+    """A request's command-line flags and its settings merged, once per command: every step
+    of a diff (and each stage of a series) reads these, never the two sources again."""
+
+    rules: LocationRules
+    gates: tuple[Gate, ...]
+    languages: tuple[tuple[str, str], ...]  # file ending -> language
+    limits: WorkerLimits
+    jobs: int
+    coupling: CouplingOptions
+    packs: RuleSet
+    dynamic_pre_zero: bool
+
+
+def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
+    """The options of ``request`` for the repository at ``root`` (its rule packs are read
+    from there). A bad gate or rule pack fails here, before any work."""
+    settings = request.settings
+    limits = worker_limits(settings.limits, settings.macros)
+    return DiffOptions(
+        rules=location_rules(request),
+        gates=tuple(parse_gate(g) for g in (*settings.gates, *request.gates)),
+        languages=settings.languages,
+        # generated files count nowhere unless asked for: the first lines that say so suffice
+        limits=replace(limits, skip_generated=not settings.include_generated),
+        jobs=request.jobs or settings.jobs,
+        coupling=coupling_options(settings),
+        packs=rule_set(settings, root),
+        dynamic_pre_zero=request.dynamic_pre_zero,
+    )
 
 
 def location_rules(request: DiffRequest) -> LocationRules:
@@ -81,13 +117,7 @@ def coupling_values(
 
     With a ``cache`` and the files' ``blobs``, the result is kept under a digest of all that
     decides it (:func:`coupling_key`) and read back when the same tree is measured again."""
-    measured = [
-        f
-        for f in files
-        if f.parsed
-        and not rules.is_excluded(f.path)
-        and not (rules.exclude_generated and f.generated)
-    ]
+    measured = measured_files(files, rules)
     key = (
         None
         if cache is None or blobs is None
@@ -261,24 +291,6 @@ def change_key(
     return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
-def pair_files(
-    pre: Sequence[FileFacts], post: Sequence[FileFacts], renames: dict[str, str]
-) -> list[FilePair]:
-    """Files paired across the revisions by path, and by git's renames (old -> new)."""
-    after = {f.path: f for f in post}
-    pairs, taken = [], set()
-    for facts in pre:
-        new_path = renames.get(facts.path, facts.path)
-        if new_path not in after and facts.path in after:
-            new_path = facts.path
-        partner = after.get(new_path)
-        if partner is not None:
-            taken.add(new_path)
-        pairs.append(FilePair(facts, partner))
-    pairs.extend(FilePair(None, f) for f in post if f.path not in taken)
-    return pairs
-
-
 def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
     seen: dict[str, ParseWarning] = {}
     for side in sides:
@@ -290,68 +302,73 @@ def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
 
 def _parse_side(
     snapshot: Snapshot,
-    request: DiffRequest,
+    options: DiffOptions,
     progress: Progress | None,
     cache: FactsCache | None,
     blobs: dict[str, str] | None = None,
 ) -> tuple[FileFacts, ...]:
-    overrides = request.settings.languages
-    selected = select(snapshot, LanguageTable.default(dict(overrides)))
-    limits = worker_limits(request.settings.limits, request.settings.macros)
-    # generated files count nowhere unless asked for: the first lines that say so suffice
-    limits = replace(limits, skip_generated=not request.settings.include_generated)
-    jobs = request.jobs or request.settings.jobs
-    return parse_all(snapshot, selected, overrides, jobs, progress, cache, limits, blobs)
+    selected = select(snapshot, LanguageTable.default(dict(options.languages)))
+    overrides = options.languages
+    return parse_all(
+        snapshot, selected, overrides, options.jobs, progress, cache, options.limits, blobs
+    )
 
 
 def measure_change(
-    request: DiffRequest, progress: Progress | None = None, cache: FactsCache | None = None
+    request: DiffRequest,
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+    checkout: Checkout | None = None,
+    options: DiffOptions | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """The change report between the two snapshots, and the parse warnings of both sides.
-    Every step is named on ``progress``: reading each side, parsing, coupling each tree,
-    comparing the files."""
+    ``checkout``: the repository, opened once by the caller (else opened here); ``options``:
+    the request's options, merged once by the caller (else here). Every step is named on
+    ``progress``: reading each side, parsing, coupling each tree, comparing the files."""
     progress = progress or NoProgress()
     progress.phase(f"reading {request.base} and {request.head}")
-    repo = git.open_repository(request.root)
-    root = git.toplevel(repo)
-    base = open_snapshot(root, request.base)
-    head = open_snapshot(root, request.head)
-    rules = location_rules(request)
+    checkout = checkout or open_checkout(request.root)
+    options = options or diff_options(request, checkout.root)
+    base, head = checkout.snapshot(request.base), checkout.snapshot(request.head)
+    rules = options.rules
     pre_blobs: dict[str, str] = {}
     post_blobs: dict[str, str] = {}
-    pre = _parse_side(base, request, progress, cache, pre_blobs)
+    pre = _parse_side(base, options, progress, cache, pre_blobs)
     progress.phase(f"reading {request.head}")
-    post = _parse_side(head, request, progress, cache, post_blobs)
-    options, packs = coupling_options(request.settings), rule_set(request.settings, root)
+    post = _parse_side(head, options, progress, cache, post_blobs)
+    coupling, packs = options.coupling, options.packs
     progress.phase(f"coupling {request.base}")
-    pre_coupling = coupling_values(pre, rules, options, packs, cache, pre_blobs)
+    pre_coupling = coupling_values(pre, rules, coupling, packs, cache, pre_blobs)
     progress.phase(f"coupling {request.head}")
-    post_coupling = coupling_values(post, rules, options, packs, cache, post_blobs)
+    post_coupling = coupling_values(post, rules, coupling, packs, cache, post_blobs)
     progress.phase("comparing the changed files")
     paths = {f.path for f in (*pre, *post)}
     change = compute_change(
-        pair_files(pre, post, git.renames(repo, request.base, request.head)),
-        group_elements(paths, options.per_file),
+        pair_files(pre, post, checkout.renames(request.base, request.head)),
+        group_elements(paths, coupling.per_file),
         rules,
         pre_coupling,
         post_coupling,
-        dynamic_pre_zero=request.dynamic_pre_zero,
+        dynamic_pre_zero=options.dynamic_pre_zero,
         diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
     progress.stop()
     return change, _warnings(pre, post)
 
 
-def gates_of(request: DiffRequest) -> tuple[Gate, ...]:
-    return tuple(parse_gate(g) for g in (*request.settings.gates, *request.gates))
-
-
 def run_diff(
-    request: DiffRequest, progress: Progress | None = None, cache: FactsCache | None = None
+    request: DiffRequest,
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+    checkout: Checkout | None = None,
+    options: DiffOptions | None = None,
 ) -> DiffReport:
-    """Measure, then check the gates."""
-    gates = gates_of(request)  # a bad gate fails before any work
-    change, warnings = measure_change(request, progress, cache)
+    """Measure, then check the gates. ``checkout`` and ``options`` as for
+    :func:`measure_change` (a series opens and merges once for all its stages)."""
+    checkout = checkout or open_checkout(request.root)
+    options = options or diff_options(request, checkout.root)  # a bad gate fails before work
+    change, warnings = measure_change(request, progress, cache, checkout, options)
+    gates = options.gates
     report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
     failures = check_gates(gates, report.summaries())
     return DiffReport(report.base, report.head, change, warnings, report.gates, failures)

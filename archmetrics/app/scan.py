@@ -25,8 +25,9 @@ from archmetrics.parsers import LanguageTable
 from archmetrics.reports.frames import scan_table
 from archmetrics.reports.json_report import totals_dict
 from archmetrics.reports.model import ScanReport
-from archmetrics.sources import SourceError, open_snapshot
+from archmetrics.sources import SourceError
 from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.checkout import open_checkout
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import DirectorySnapshot, Snapshot, resolve_path
 
@@ -45,8 +46,6 @@ class ScanRequest:
 
 def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
     """The root, the snapshot and the path prefixes (relative to root) to keep."""
-    from archmetrics.sources import git
-
     targets = [resolve_path(p) for p in request.paths] or [Path.cwd().resolve()]
     for target in targets:
         if not target.exists() and request.rev is None:
@@ -54,7 +53,8 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
     anchor = targets[0] if targets[0].is_dir() else targets[0].parent
     if request.plain_directory:
         return anchor, DirectorySnapshot(anchor), ()
-    if request.rev is None and not git.is_repository(anchor):
+    checkout = open_checkout(anchor)
+    if request.rev is None and checkout.repo is None:
         if len(targets) == 1 and targets[0].is_dir():
             return targets[0], DirectorySnapshot(targets[0]), ()
         root = Path(os.path.commonpath([str(t) for t in targets]))
@@ -62,9 +62,8 @@ def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
         on_disk = [t.relative_to(root).as_posix() if t != root else "" for t in targets]
         folder = DirectorySnapshot(root, within=on_disk)
         return root, folder, tuple(_relative(t, root) for t in targets)
-    repo = git.open_repository(anchor)
-    root = git.toplevel(repo).resolve()
-    snapshot = open_snapshot(root, request.rev)
+    root = checkout.root.resolve()
+    snapshot = checkout.snapshot(request.rev)
     prefixes = tuple(_relative(t, root) for t in targets)
     return root, snapshot, tuple(p for p in prefixes if p)
 

@@ -6,15 +6,16 @@ against ``root``), as the thesis measured its baseline, first and second stages 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import DiffRequest, diff_options, run_diff
 from archmetrics.app.progress import Progress
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources import EMPTY
 from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.checkout import Checkout, open_checkout
 
 
 class SeriesError(ValueError):
@@ -45,12 +46,21 @@ def stage_pairs(request: SeriesRequest) -> list[tuple[str, str, str]]:
 
 
 def run_series(
-    request: SeriesRequest, progress: Progress | None = None, cache: FactsCache | None = None
+    request: SeriesRequest,
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+    checkout: Checkout | None = None,
 ) -> SeriesReport:
+    """Each stage against the one before it; ``checkout``: the repository, if the caller
+    opened it already."""
+    pairs = stage_pairs(request)
+    checkout = checkout or open_checkout(request.diff.root)  # once for all stages, as are
+    # the options
+    options = diff_options(request.diff, checkout.root)
     stages = []
-    for label, base, head in stage_pairs(request):
-        report = run_diff(replace(request.diff, base=base, head=head), progress, cache)
-        stages.append(Stage(label, report))
+    for label, base, head in pairs:
+        stage = replace(request.diff, base=base, head=head)
+        stages.append(Stage(label, run_diff(stage, progress, cache, checkout, options)))
     return SeriesReport(str(request.diff.root), tuple(stages))
 
 
@@ -58,12 +68,17 @@ def run_compare(
     named: Sequence[tuple[str, SeriesRequest]],
     progress: Progress | None = None,
     cache: FactsCache | None = None,
+    checkouts: Mapping[str, Checkout] | None = None,
 ) -> CompareReport:
-    """One series per named repository, side by side."""
+    """One series per named repository, side by side; ``checkouts``: the repositories the
+    caller opened already, by name."""
     names = [name for name, _ in named]
     if len(set(names)) != len(names):
         raise SeriesError(f"each repository needs its own name: {', '.join(names)}")
-    return CompareReport(tuple((name, run_series(r, progress, cache)) for name, r in named))
+    opened = checkouts or {}
+    return CompareReport(
+        tuple((name, run_series(r, progress, cache, opened.get(name))) for name, r in named)
+    )
 
 
 def parse_named_path(text: str) -> tuple[str, Path]:

@@ -13,19 +13,22 @@ from archmetrics.config import Settings, load_settings
 
 def repo_root(path: Path) -> Path:
     """The top of the git repository holding ``path``, or its folder outside git."""
-    from archmetrics.sources import git
+    from archmetrics.sources.checkout import open_checkout
 
-    folder = path if path.is_dir() else path.parent
-    if git.is_repository(folder):
-        return git.toplevel(git.open_repository(folder))
-    return folder
+    return open_checkout(path if path.is_dir() else path.parent).root
 
 
 def settings_for(path: Path, exclude: Sequence[str] = ()) -> Settings:
     """The settings of the repository or folder holding ``path``, with ``exclude`` after the
     configured globs (each checked now: :class:`~archmetrics.changeset.locations.BadPattern`
     names a bad one)."""
-    settings = load_settings(repo_root(path))
+    return settings_at(repo_root(path), exclude)
+
+
+def settings_at(root: Path, exclude: Sequence[str] = ()) -> Settings:
+    """The settings of the repository or folder whose top is ``root`` (a command that has
+    opened it already knows its top), with ``exclude`` as for :func:`settings_for`."""
+    settings = load_settings(root)
     for glob in exclude:
         compile_glob(glob)
     if not exclude:

@@ -35,67 +35,23 @@ from archmetrics.changeset.elements import (
     element_change,
     element_index,
 )
+from archmetrics.changeset.files import measured_pairs
 from archmetrics.changeset.locations import Location, LocationRules
 from archmetrics.changeset.model import (
     ChangeReport,
     Coupling,
     ElementChange,
-    ExcludedFile,
     FilePair,
     Metrics,
 )
 from archmetrics.changeset.statement_diff import diff_files
 from archmetrics.coupling.elements import group_elements
 from archmetrics.coupling.model import CouplingReport
-from archmetrics.facts import FileFacts
 
 
 def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
     """The coupling layer's per-element results as the mapping :func:`compute_change` takes."""
     return {e.element.name: Coupling(e.s_a, e.s_e, e.d_a, e.d_e) for e in report.elements}
-
-
-def _side_exclusion(facts: FileFacts | None, rules: LocationRules) -> str | None:
-    """Why one side of a pair is left out (its path's exclude glob, or generated), or None."""
-    if facts is None:
-        return None
-    if reason := rules.is_excluded(facts.path):
-        return reason
-    return "generated" if rules.exclude_generated and facts.generated else None
-
-
-def _filter(pair: FilePair, rules: LocationRules) -> tuple[FilePair | None, list[ExcludedFile]]:
-    """The measured part of a pair and what was left out of it.
-
-    A side that could not be parsed drops the whole pair (diffing it would show every
-    statement as added or removed). An excluded side alone drops only that side: a file that
-    leaves ``generated/`` for hand-written code is an addition.
-    """
-    sides = [f for f in (pair.pre, pair.post) if f is not None]
-    if any(not f.parsed for f in sides):
-        return None, [ExcludedFile(pair.path, "not_parsed")]
-    reasons = (_side_exclusion(pair.pre, rules), _side_exclusion(pair.post, rules))
-    excluded = {
-        ExcludedFile(f.path, r)
-        for f, r in zip((pair.pre, pair.post), reasons, strict=True)
-        if f and r
-    }
-    pre = None if reasons[0] else pair.pre
-    post = None if reasons[1] else pair.post
-    kept = FilePair(pre, post) if pre or post else None
-    return kept, sorted(excluded, key=lambda x: (x.path, x.reason))
-
-
-def _partition(
-    pairs: Iterable[FilePair], rules: LocationRules
-) -> tuple[list[FilePair], list[ExcludedFile]]:
-    kept: list[FilePair] = []
-    excluded: list[ExcludedFile] = []
-    for pair in pairs:
-        measured, left_out = _filter(pair, rules)
-        kept += [measured] if measured else []
-        excluded += left_out
-    return kept, sorted(excluded, key=lambda x: (x.path, x.reason))
 
 
 def _sums(elements: Iterable[ElementChange]) -> Sums:
@@ -136,7 +92,7 @@ def compute_change(
     diff: Differ = diff_files,
 ) -> ChangeReport:
     """Chapter 6 metrics of one comparison: per location, total, per element, exclusions."""
-    kept, excluded = _partition(pairs, rules)
+    kept, excluded = measured_pairs(pairs, rules)
     if elements is None:
         paths = {f.path for p in kept for f in (p.pre, p.post) if f is not None}
         elements = group_elements(paths)

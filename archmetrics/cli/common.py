@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
@@ -102,8 +102,19 @@ def sample_path() -> Path:
 def settings_for(path: Path, args: argparse.Namespace | None = None) -> Settings:
     """The configuration of the repository (or folder) holding ``path``, with the command
     line's ``--exclude`` globs after the configured ones (each checked now, exit 2 if bad)."""
+    return _with_excludes(app_settings.settings_for, path, args)
+
+
+def settings_at(root: Path, args: argparse.Namespace | None = None) -> Settings:
+    """As :func:`settings_for`, of the repository whose top the command has opened."""
+    return _with_excludes(app_settings.settings_at, root, args)
+
+
+def _with_excludes(
+    load: Callable[[Path, tuple[str, ...]], Settings], path: Path, args: argparse.Namespace | None
+) -> Settings:
     try:
-        return app_settings.settings_for(path, tuple(getattr(args, "exclude", None) or ()))
+        return load(path, tuple(getattr(args, "exclude", None) or ()))
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
 

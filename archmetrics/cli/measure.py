@@ -19,6 +19,7 @@ from archmetrics.cli.common import (
     facts_cache,
     gate_status,
     sample_path,
+    settings_at,
     settings_for,
     shown_progress,
     split,
@@ -32,7 +33,7 @@ from archmetrics.reports.formats import (
     render_series,
 )
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
-from archmetrics.sources.git import tags_in_order
+from archmetrics.sources.checkout import Checkout, open_checkout
 from archmetrics.sources.snapshot import resolve_path
 
 
@@ -157,13 +158,15 @@ def revisions_to_compare(args: argparse.Namespace) -> tuple[str, str]:
 
 
 def diff_request(
-    args: argparse.Namespace, repo: Path, base: str = "", head: str = ""
+    args: argparse.Namespace, checkout: Checkout, base: str = "", head: str = ""
 ) -> DiffRequest:
+    """The command line's diff, in the repository the command opened: flags and settings
+    are merged from here on once (``app.diff.diff_options``)."""
     return DiffRequest(
-        root=repo,
+        root=checkout.root,
         base=base,
         head=head,
-        settings=settings_for(repo, args),
+        settings=settings_at(checkout.root, args),
         new=tuple(args.new),
         framework=tuple(args.framework),
         gates=tuple(args.fail_on),
@@ -175,11 +178,12 @@ def diff_request(
 def series_command(args: argparse.Namespace) -> int:
     check_chart(args)
     fmt = OutputFormat(args.format)
+    checkout = open_checkout(args.repo)
     request = SeriesRequest(
-        diff_request(args, args.repo), tuple(args.revisions), split(args.labels), args.root
+        diff_request(args, checkout), tuple(args.revisions), split(args.labels), args.root
     )
     with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
-        report = run_series(request, p, cache)
+        report = run_series(request, p, cache, checkout)
         p.phase("writing the report")
         text = render_series(report, fmt, args.max_rows)
     emit(text, args.output)
@@ -191,14 +195,19 @@ def compare_command(args: argparse.Namespace) -> int:
     check_chart(args)
     fmt = OutputFormat(args.format)
     named = []
+    checkouts: dict[str, Checkout] = {}
     for text in args.repos:
         name, path = parse_named_path(text)
-        revisions = split(args.revisions) or tags_in_order(path)
-        request = SeriesRequest(diff_request(args, path), revisions, split(args.labels), args.root)
+        checkout = open_checkout(path)
+        revisions = split(args.revisions) or checkout.tags()
+        request = SeriesRequest(
+            diff_request(args, checkout), revisions, split(args.labels), args.root
+        )
         named.append((name, request))
+        checkouts[name] = checkout
     settings = named[0][1].diff.settings
     with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as p:
-        report = run_compare(named, p, cache)
+        report = run_compare(named, p, cache, checkouts)
         p.phase("writing the report")
         text = render_compare(report, fmt)
     emit(text, args.output)
@@ -210,10 +219,11 @@ def diff_command(args: argparse.Namespace) -> int:
     check_chart(args)
     fmt = OutputFormat(args.format)
     base, head = revisions_to_compare(args)
-    request = diff_request(args, args.repo, base, head)
+    checkout = open_checkout(args.repo)
+    request = diff_request(args, checkout, base, head)
     settings = request.settings
     with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
-        report = run_diff(request, progress, cache)
+        report = run_diff(request, progress, cache, checkout)
         progress.phase("writing the report")
         text = render_diff(report, fmt, args.max_rows)
     emit(text, args.output)

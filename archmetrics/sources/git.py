@@ -50,13 +50,22 @@ def is_repository(path: Path) -> bool:
 
 def open_repository(path: Path) -> git.Repo:
     """The repository holding ``path``, its git commands set to :data:`READ_ONLY`."""
+    repo = find_repository(path)
+    if repo is None:
+        if not path.exists():
+            raise SourceError(f"{path}: no such directory")
+        raise SourceError(f"{path}: not inside a git repository")
+    return repo
+
+
+def find_repository(path: Path) -> git.Repo | None:
+    """The repository holding ``path`` (its git commands set to :data:`READ_ONLY`), or None
+    when no repository holds it; SourceError when one does but git cannot read it."""
     try:
         repo = git.Repo(path, search_parent_directories=True)
-    except NoSuchPathError as error:
-        raise SourceError(f"{path}: no such directory") from error
-    except InvalidGitRepositoryError as error:
-        raise SourceError(f"{path}: not inside a git repository") from error
-    except OSError as error:
+    except (InvalidGitRepositoryError, NoSuchPathError):
+        return None
+    except OSError as error:  # a symbolic-link loop, a folder we may not read
         raise SourceError(f"{path}: cannot read: {error.strerror or error}") from error
     repo.git.update_environment(**READ_ONLY)
     try:  # git's own checks (ownership, a broken .git) fail here, not halfway through
@@ -263,12 +272,12 @@ def renames(repo: git.Repo, base: str, head: str) -> dict[str, str]:
     return pairs
 
 
-def tags_in_order(path: Path) -> tuple[str, ...]:
+def tags_in_order(repo: git.Repo) -> tuple[str, ...]:
     """The repository's tags in history order (by how many commits lie behind each, then by
     name): the stages of a study subject, oldest first."""
-    repo = open_repository(path)
     names = [str(tag) for tag in repo.tags]
     if not names:
-        raise SourceError(f"{path}: no tags to take stages from; give --revisions")
+        where = repo.working_tree_dir or repo.git_dir
+        raise SourceError(f"{where}: no tags to take stages from; give --revisions")
     depth = {name: _count(repo, resolve(repo, name)) for name in names}
     return tuple(sorted(names, key=lambda name: (depth[name], name)))

@@ -1,0 +1,80 @@
+"""A repository or folder opened once per command: where its settings, snapshots and renames
+come from.
+
+Opening a repository costs a GitPython object and a ``git rev-parse`` (git's own ownership
+and sanity checks run there). A command opens its repository once, as a :class:`Checkout`,
+and asks it for every snapshot, rename list and tag it needs; the settings and rule packs are
+read from its ``root``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from archmetrics.sources.snapshot import (
+    EMPTY,
+    INDEX,
+    WORKTREE,
+    DirectorySnapshot,
+    EmptySnapshot,
+    Snapshot,
+    SourceError,
+)
+
+if TYPE_CHECKING:
+    import git as gitpython
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Checkout:
+    """``root``: the top of the repository (or the folder, outside git); ``repo``: the
+    repository, None outside git."""
+
+    root: Path
+    repo: gitpython.Repo | None = None
+
+    def snapshot(self, spec: str | None) -> Snapshot:
+        """The snapshot ``spec`` names: None (the files on disk), ``EMPTY``, ``WORKTREE``,
+        ``INDEX`` or any git revision (outside git, only None and ``EMPTY``)."""
+        from archmetrics.sources import git
+
+        if spec == EMPTY:
+            return EmptySnapshot()
+        if self.repo is None:
+            if spec is None:
+                return DirectorySnapshot(self.root)
+            raise SourceError(f"{self.root}: not inside a git repository")
+        if spec is not None and git.effective_spec(self.repo, spec) == EMPTY:
+            return EmptySnapshot(label=f"{spec} (no commits yet)")
+        if spec is None or spec == WORKTREE:
+            return git.WorktreeSnapshot(self.repo)
+        if spec == INDEX:
+            return git.IndexSnapshot(self.repo)
+        return git.RevisionSnapshot(self.repo, spec)
+
+    def renames(self, base: str, head: str) -> dict[str, str]:
+        """Paths git finds renamed from ``base`` to ``head``, old -> new (none outside git)."""
+        from archmetrics.sources import git
+
+        return {} if self.repo is None else git.renames(self.repo, base, head)
+
+    def tags(self) -> tuple[str, ...]:
+        """The repository's tags, oldest first (``git.tags_in_order``)."""
+        from archmetrics.sources import git
+
+        if self.repo is None:
+            raise SourceError(f"{self.root}: not inside a git repository")
+        return git.tags_in_order(self.repo)
+
+
+def open_checkout(path: Path) -> Checkout:
+    """The repository holding ``path``, opened, or the folder ``path`` (or a file's folder)
+    outside git."""
+    from archmetrics.sources import git
+
+    repo = git.find_repository(path)
+    if repo is None:
+        return Checkout(path if path.is_dir() or not path.exists() else path.parent)
+    return Checkout(git.toplevel(repo), repo)
