@@ -220,6 +220,29 @@ def _read_endpoint(
     return found
 
 
+class LinkFilter:
+    """Whether a rule names one of a file's callees or functions: a file for which this is
+    False has no link site, whatever it includes or imports (``requires`` and ``unless_from``
+    only narrow what these names match), so nothing more of it need be read or traced."""
+
+    def __init__(self, rules: RuleSet) -> None:
+        self.rules = rules
+        self._indexes: dict[str, tuple[RuleIndex, RuleIndex]] = {}
+
+    def __call__(self, facts: FileFacts) -> bool:
+        indexes = self._indexes.get(facts.language)
+        if indexes is None:
+            usable = self.rules.for_language(facts.language)
+            indexes = self._indexes[facts.language] = (
+                rule_index(tuple(r for r in usable if r.site is SiteKind.CALL)),
+                rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION)),
+            )
+        calls, definitions = indexes
+        if any(map(calls.choose, facts.callees())):
+            return True
+        return any(definitions.choose(f.qualified_name) for f in facts.functions)
+
+
 def file_link_sites(
     facts: FileFacts,
     rules: RuleSet,

@@ -42,6 +42,14 @@ class ModuleIndex:
         self.files = frozenset(f for f in files if f.endswith(".py"))
         self.folders = frozenset(folder for f in self.files for folder in _ancestors(f))
         self.roots = tuple(roots) if roots is not None else self._detect_roots()
+        # what each folder holds by module name (``x`` for x.py and for the folder x): a
+        # root that holds no first part of an import cannot locate it, and most imports
+        # (os, sys, numpy ...) are in no root at all
+        self._names: dict[str, set[str]] = {}
+        for path in (*self.files, *self.folders):
+            folder, _, name = path.rpartition("/")
+            if name:
+                self._names.setdefault(folder, set()).add(name.removesuffix(".py"))
         self._found: dict[tuple[tuple[str, ...], tuple[str, ...]], tuple[str, str | None] | None]
         self._found = {}  # every file imports os, sys, numpy ...: each lookup is made once
 
@@ -97,7 +105,16 @@ class ModuleIndex:
         key = (roots, tuple(parts))
         if key in self._found:
             return self._found[key]
-        found = next((hit for root in roots if (hit := self.locate(root, parts))), None)
+        first = parts[0] if parts else None
+        found = next(
+            (
+                hit
+                for root in roots
+                if (first is None or first in self._names.get(root, ()))
+                and (hit := self.locate(root, parts))
+            ),
+            None,
+        )
         self._found[key] = found
         return found
 

@@ -6,7 +6,7 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 
 from archmetrics.coupling.bindings import module_bindings
-from archmetrics.coupling.dynamic import file_link_sites, resolve
+from archmetrics.coupling.dynamic import LinkFilter, file_link_sites, resolve
 from archmetrics.coupling.elements import Element, element_of_file, group_elements
 from archmetrics.coupling.endpoints import Lookup, Value, constants_of
 from archmetrics.coupling.model import (
@@ -117,8 +117,12 @@ class _Sites:
         self.rules, self.constants, self.memo = rules, constants, memo
 
     def of(self, elements: Sequence[Element]) -> dict[str, tuple[LinkSite, ...]]:
+        by_path, may_link = self.by_path, LinkFilter(self.rules)
         plans = [
-            (e, path, _reachable(path, self.occurrences)) for e in elements for path in e.files
+            (e, path, _reachable(path, self.occurrences))
+            for e in elements
+            for path in e.files
+            if may_link(by_path[path])
         ]
         known: dict[str, tuple[LinkSite, ...]] = {}
         keys: dict[str, str] = {}

@@ -130,11 +130,12 @@ class FactsCache:
         self.hits = 0
         self.misses = 0
         self.notices: list[str] = []  # problems recovered from, for the user to see
-        # Facts this run already decoded or parsed, by (blob, language): a diff asks for most
-        # blobs twice (the file is unchanged between base and head), and decoding is the
-        # warm path's main cost. Frozen facts are safe to share (and sharing them halves a
-        # diff's memory); bounded so a long series of revisions does not hold every version.
-        self._decoded: dict[tuple[str, str], FileFacts] = {}
+        # Facts this run already decoded or parsed, by (blob, language, path): a diff asks for
+        # most files twice (unchanged between base and head), and decoding is the warm
+        # path's main cost; facts name their file, so copies of one blob at several paths
+        # (vendored trees) are each kept. Frozen facts are safe to share (and sharing them
+        # halves a diff's memory); bounded so a long series does not hold every version.
+        self._decoded: dict[tuple[str, str, str], FileFacts] = {}
         self._db = open_database(self.path, self.notices)
         # a read-only cache made before the bodies table holds no facts of this version
         self._bodies = self._run(
@@ -162,8 +163,8 @@ class FactsCache:
             return query(self._db)
 
     def get(self, blob: str, language: str, path: str) -> FileFacts | None:
-        known = self._decoded.get((blob, language))
-        if known is not None and known.path == path:
+        known = self._decoded.get((blob, language, path))
+        if known is not None:
             self.hits += 1
             return known
         key = (blob, language, self.fingerprint)
@@ -199,7 +200,8 @@ class FactsCache:
             live = cache()
             if live is not None and not live._closed:
                 with contextlib.suppress(CacheError, sqlite3.Error):
-                    live._decoded.pop((blob, language), None)
+                    for kept in [k for k in live._decoded if k[:2] == (blob, language)]:
+                        del live._decoded[kept]
                     live._forget(key)
 
         return forget
@@ -239,7 +241,7 @@ class FactsCache:
         blob, language and path returns them without reading or decoding."""
         if len(self._decoded) >= DECODED_LIMIT:
             self._decoded.clear()
-        self._decoded[(blob, facts.language)] = facts
+        self._decoded[(blob, facts.language, facts.path)] = facts
 
     def put_many(self, items: Iterable[tuple[str, FileFacts]]) -> None:
         self.put_encoded((blob, f.language, codec.encode(f)) for blob, f in items)
