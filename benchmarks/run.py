@@ -3,7 +3,7 @@
 Run from a clean clone:
     .venv/bin/pip install -e '.[bench]' && .venv/bin/python benchmarks/run.py
 Options: --repeat N (runs per measure, median taken), --jobs N, --only scan-c scan-py diff
-edit growth, --single (archmetrics with one worker too), --releases A B.
+edit edit-10x growth, --single (archmetrics with one worker too), --releases A B.
 Downloads and trees are kept in benchmarks/.work (gitignored) and reused. Prints a Markdown
 table for docs/performance.md and writes it, with every run, to benchmarks/.work/results.*.
 Not part of the test suite.
@@ -26,7 +26,7 @@ from corpus import BenchError, Tree
 from measure import Summary, power_fit, repeat
 
 HERE = Path(__file__).resolve().parent
-TASKS = ("scan-c", "scan-py", "diff", "edit", "growth")
+TASKS = ("scan-c", "scan-py", "diff", "edit", "edit-10x", "growth")
 
 
 @dataclass(frozen=True, slots=True)
@@ -179,17 +179,66 @@ def edit_rows(bench: Bench, history: Path, tag: str) -> list[report.Result]:
     diff = [tool, "diff", "-C", str(clone), "--base", "HEAD", "--head", "WORKTREE", "-q"]
     diff += ["-j", str(bench.jobs), "--format", "json", "--cache-path", str(cache)]
     bench.repeat("edit.warm-up", diff)  # both trees' facts and coupling cached
+    ours = bench.repeat("edit.diff", diff, before=_appender(target))
+    scan = [tool, "scan", str(target), "-q", "--format", "json", "--cache-path", str(cache)]
+    theirs = bench.repeat("edit.scan", scan)
+    measure = f"diff HEAD..WORKTREE after editing {target.relative_to(clone)}, warm"
+    return [report.Row(measure, None, ours, theirs, "one-file scan", 1 / 3)]
+
+
+def copies_repository(bench: Bench, tree: Path, copies: int) -> Path:
+    """A repository whose one commit holds ``copies`` copies of ``tree``, under c0, c1 ...
+    (hard links where possible): the same code base, ``copies`` times the files. Reused."""
+    repo = bench.work / f"copies-{copies}"
+    if (repo / ".git").exists() and corpus.git(repo, "tag", "--list").split() == ["built"]:
+        corpus.git(repo, "checkout", "-q", "--", ".")  # an earlier run's edits undone
+        return repo
+    if repo.exists():
+        shutil.rmtree(repo)
+    repo.mkdir(parents=True)
+    for index in range(copies):
+        shutil.copytree(tree, repo / f"c{index}", symlinks=True, copy_function=os.link)
+    corpus.git(repo, "init", "-q")
+    corpus.git(repo, "add", "--all", "--force", ".")
+    corpus.git(repo, "commit", "-q", "--no-verify", "-m", f"{copies} copies")
+    corpus.git(repo, "tag", "built")
+    return repo
+
+
+def edit_growth_rows(bench: Bench, tree: Path) -> list[report.Result]:
+    """issue 14: the warm edit diff of ``edit_rows`` in a repository of ten copies of the
+    head tree against the same in a repository of one copy; goal: at most 1.5x."""
+    summaries = []
+    for copies in (1, 10):
+        repo = copies_repository(bench, tree, copies)
+        target = repo / "c0" / EDITED
+        if not target.is_file():
+            target = max((repo / "c0").rglob("*.c"), key=lambda p: p.stat().st_size)
+        cache = bench.work / f"copies-{copies}-cache.sqlite3"
+        _remove(cache)
+        tool = bench.tool("archmetrics")
+        diff = [tool, "diff", "-C", str(repo), "--base", "HEAD", "--head", "WORKTREE", "-q"]
+        diff += ["-j", str(bench.jobs), "--format", "json", "--cache-path", str(cache)]
+        bench.repeat(f"edit-{copies}x.warm-up", diff)
+        edit = _appender(target)
+        name = f"edit-{copies}x.diff"
+        summaries.append(bench.repeat(name, diff, before=edit, sample_memory=True))
+    measure = "diff HEAD..WORKTREE after an edit, warm, 10 copies of the tree"
+    return [
+        report.Row(measure, None, summaries[1], summaries[0], "the same with 1 copy", 1 / 1.5),
+        report.MemoryRow("peak memory, edit diff, 10 copies", summaries[1], 1000.0),
+    ]
+
+
+def _appender(target: Path) -> Callable[[], None]:
+    """An edit of ``target``: a new function appended at each call."""
     edits = iter(range(1_000_000))
 
     def edit() -> None:
         with target.open("a") as file:
             file.write(f"\nint archmetrics_bench_edit_{next(edits)}(int x) {{ return x; }}\n")
 
-    ours = bench.repeat("edit.diff", diff, before=edit)
-    scan = [tool, "scan", str(target), "-q", "--format", "json", "--cache-path", str(cache)]
-    theirs = bench.repeat("edit.scan", scan)
-    measure = f"diff HEAD..WORKTREE after editing {target.relative_to(clone)}, warm"
-    return [report.Row(measure, None, ours, theirs, "one-file scan", 1 / 3)]
+    return edit
 
 
 def _remove(path: Path) -> None:
@@ -252,6 +301,7 @@ def run(
         ),
         "diff": lambda: diff_rows(bench, history, sources, tags),
         "edit": lambda: edit_rows(bench, history, tags[1]),
+        "edit-10x": lambda: edit_growth_rows(bench, head),
         "growth": lambda: growth(bench, head),
     }
     rows: list[report.Result] = []
