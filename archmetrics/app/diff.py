@@ -288,7 +288,7 @@ def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
     return tuple(seen.values())
 
 
-def _parse_side(
+def parse_side(
     snapshot: Snapshot,
     request: DiffRequest,
     progress: Progress | None,
@@ -316,21 +316,37 @@ def measure_change(
     root = git.toplevel(repo)
     base = open_snapshot(root, request.base)
     head = open_snapshot(root, request.head)
+    renames = git.renames(repo, request.base, request.head)
+    return measure_snapshots(request, root, (base, head), renames, progress, cache)
+
+
+def measure_snapshots(
+    request: DiffRequest,
+    root: Path,
+    snapshots: tuple[Snapshot, Snapshot],
+    renames: dict[str, str],
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
+    """:func:`measure_change` of two snapshots already opened (``root``: the repository's
+    top, for its rule packs; ``renames``: old path -> new path)."""
+    progress = progress or NoProgress()
+    base, head = snapshots
     rules = location_rules(request)
     pre_blobs: dict[str, str] = {}
     post_blobs: dict[str, str] = {}
-    pre = _parse_side(base, request, progress, cache, pre_blobs)
-    progress.phase(f"reading {request.head}")
-    post = _parse_side(head, request, progress, cache, post_blobs)
+    pre = parse_side(base, request, progress, cache, pre_blobs)
+    progress.phase(f"reading {head.label}")
+    post = parse_side(head, request, progress, cache, post_blobs)
     options, packs = coupling_options(request.settings), rule_set(request.settings, root)
-    progress.phase(f"coupling {request.base}")
+    progress.phase(f"coupling {base.label}")
     pre_coupling = coupling_values(pre, rules, options, packs, cache, pre_blobs)
-    progress.phase(f"coupling {request.head}")
+    progress.phase(f"coupling {head.label}")
     post_coupling = coupling_values(post, rules, options, packs, cache, post_blobs)
     progress.phase("comparing the changed files")
     paths = {f.path for f in (*pre, *post)}
     change = compute_change(
-        pair_files(pre, post, git.renames(repo, request.base, request.head)),
+        pair_files(pre, post, renames),
         group_elements(paths, options.per_file),
         rules,
         pre_coupling,

@@ -183,6 +183,18 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    estimate = commands.add_parser(
+        "estimate",
+        help="price an integration before doing it: each architecture of a plan (TOML) or"
+        " sketch estimated against a measured base, ranked (docs/estimate.md)",
+    )
+    estimate.add_argument("plan", metavar="PLAN", help="the plan file (TOML, docs/estimate.md)")
+    estimate.add_argument(
+        "--base", default="HEAD", help="the revision the plan applies to (default HEAD)"
+    )
+    estimate.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    add_locations(estimate)
+    add_output(estimate, [f.value for f in OutputFormat])
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )

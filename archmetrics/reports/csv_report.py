@@ -6,8 +6,14 @@ from __future__ import annotations
 import csv
 import io
 
-from archmetrics.reports.frames import Table, diff_table, scan_table, trend_table
-from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
+from archmetrics.reports.frames import Table, diff_table, estimate_table, scan_table, trend_table
+from archmetrics.reports.model import (
+    CompareReport,
+    DiffReport,
+    EstimateReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def _csv(table: Table) -> str:
@@ -36,3 +42,9 @@ def render_series(report: SeriesReport) -> str:
 
 def render_compare(report: CompareReport) -> str:
     return _csv(trend_table(report))
+
+
+def render_estimate(report: EstimateReport) -> str:
+    """The diff's rows (a row per location, then per element) for every architecture and
+    stage, named in the first two columns."""
+    return _csv(estimate_table(report))

@@ -16,6 +16,7 @@ from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -110,3 +111,16 @@ def _trend_rows(approach: str, series: SeriesReport) -> list[tuple[Cell, ...]]:
             values = tuple(getattr(summary, f) for f, _ in TREND_FIELDS)
             rows.append((approach, stage.label, location, *values))
     return rows
+
+
+def estimate_table(report: EstimateReport) -> Table:
+    """:func:`diff_table` of every architecture's stages, with ``architecture`` and ``stage``
+    columns in front (an estimate: planned or sketched figures)."""
+    columns: tuple[str, ...] = ()
+    rows: list[tuple[Cell, ...]] = []
+    for architecture in report.architectures:
+        for stage in architecture.series.stages:
+            table = diff_table(stage.report)
+            columns = ("architecture", "stage", *table.columns)
+            rows += [(architecture.name, stage.label, *row) for row in table.rows]
+    return Table(columns, rows)

@@ -12,10 +12,12 @@ from archmetrics.reports import coupling_rows
 from archmetrics.reports.model import (
     COMPARE_SCHEMA,
     DIFF_SCHEMA,
+    ESTIMATE_SCHEMA,
     SCAN_SCHEMA,
     SERIES_SCHEMA,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -152,3 +154,40 @@ def compare_dict(report: CompareReport) -> dict[str, Any]:
 
 def render_compare(report: CompareReport) -> str:
     return dumps(compare_dict(report))
+
+
+def estimate_dict(report: EstimateReport) -> dict[str, Any]:
+    """Each architecture's stages as the diff JSON has them, and the ranking; ``estimate``
+    is always true: these are planned or sketched figures, not the integration measured."""
+    architectures = {}
+    for architecture in report.architectures:
+        document = series_dict(architecture.series)
+        architectures[architecture.name] = {
+            "kind": architecture.kind,
+            "description": architecture.description,
+            "stages": document["stages"],
+        }
+    failed = {(f.architecture, f.stage, f.failure.gate.text) for f in report.failures}
+    return {
+        "schema": ESTIMATE_SCHEMA,
+        "estimate": True,
+        "plan": report.plan,
+        "base": report.base,
+        "architectures": architectures,
+        "ranking": [
+            {
+                "stage": r.stage,
+                "rank": r.rank,
+                "architecture": r.architecture,
+                "cost": r.cost,
+                "scaled_changes": r.scaled_changes,
+                "scaled_delta_vg": r.scaled_delta_vg,
+            }
+            for r in report.ranking()
+        ],
+        "failures": [{"architecture": a, "stage": s, "gate": g} for a, s, g in sorted(failed)],
+    }
+
+
+def render_estimate(report: EstimateReport) -> str:
+    return dumps(estimate_dict(report))

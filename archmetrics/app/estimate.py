@@ -1,0 +1,251 @@
+"""The ``estimate`` use case: an integration plan priced against a measured base (p. 109).
+
+The base revision is parsed and coupled as ``diff`` would, so λ, Vg and coupling before are
+the repository's; each architecture's stages are either planned counts applied to it
+(changeset/estimate.py) or sketches (a revision, a patch, a folder of stubs) measured
+against it as ``diff`` measures. Either way the result is labelled an estimate.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from archmetrics.app.coupling import coupling_options, rule_set
+from archmetrics.app.diff import (
+    DiffRequest,
+    gates_of,
+    location_rules,
+    measure_snapshots,
+    parse_side,
+    site_memo,
+)
+from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.changeset import ChangeReport, FilePair, compute_change, coupling_by_element
+from archmetrics.changeset.estimate import BaseState, apply_stages, base_state, rule_roles
+from archmetrics.changeset.gates import Gate, check_gates
+from archmetrics.changeset.plan import Architecture, Plan, PlanError, Sketch, SketchKind
+from archmetrics.changeset.plan_read import MAX_PLAN_BYTES, read_plan
+from archmetrics.coupling import group_elements, measure_coupling
+from archmetrics.facts import FileFacts, ParseWarning
+from archmetrics.reports.model import (
+    ArchitectureEstimate,
+    DiffReport,
+    EstimateFailure,
+    EstimateReport,
+    SeriesReport,
+    Stage,
+)
+from archmetrics.sources import Snapshot, SourceError, git, open_snapshot
+from archmetrics.sources.cache import FactsCache
+from archmetrics.sources.sketch import patch_overlay, stubs_overlay
+
+if TYPE_CHECKING:
+    from git import Repo
+
+__all__ = ["EstimateRequest", "measure_base", "read_plan_file", "run_estimate"]
+
+
+@dataclass(frozen=True, slots=True)
+class EstimateRequest:
+    """Price ``plan`` against ``diff.base`` in the repository at ``diff.root`` (``diff.head``
+    is not used: each architecture says what it adds)."""
+
+    plan: Path
+    diff: DiffRequest
+
+
+def read_plan_file(path: Path) -> Plan:
+    """The plan in the file at ``path`` (read at most one byte past the size limit)."""
+    source = str(path)
+    try:
+        with path.open("rb") as stream:
+            data = stream.read(MAX_PLAN_BYTES + 1)
+    except OSError as error:
+        raise PlanError(source, "", f"cannot read: {error.strerror or error}") from None
+    return read_plan(data, source)
+
+
+@dataclass(frozen=True, slots=True)
+class _Context:
+    """What every architecture is measured with: the repository, its base and its rules."""
+
+    request: DiffRequest
+    root: Path
+    repo: Repo  # for renames between sketch revisions
+    base: Snapshot
+    state: BaseState
+    warnings: tuple[ParseWarning, ...]
+    progress: Progress
+    cache: FactsCache | None
+
+
+def measure_base(
+    request: DiffRequest,
+    root: Path,
+    snapshot: Snapshot,
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+) -> tuple[BaseState, tuple[ParseWarning, ...]]:
+    """Every element of the base with its λ, Vg, location and coupling, as ``diff`` counts
+    them (the base compared with itself: same exclusions, elements and coupling)."""
+    progress = progress or NoProgress()
+    blobs: dict[str, str] = {}
+    files = parse_side(snapshot, request, progress, cache, blobs)
+    rules = location_rules(request)
+    options, packs = coupling_options(request.settings), rule_set(request.settings, root)
+    progress.phase(f"coupling {snapshot.label}")
+    measured = [
+        f
+        for f in files
+        if f.parsed
+        and not rules.is_excluded(f.path)
+        and not (rules.exclude_generated and f.generated)
+    ]
+    memo = site_memo(cache, measured, blobs, options, packs) if cache is not None else None
+    coupling = measure_coupling(measured, options, packs, memo)
+    values = coupling_by_element(coupling)
+    change = compute_change(
+        [FilePair(f, f) for f in files],
+        group_elements({f.path for f in files}, options.per_file),
+        rules,
+        values,
+        values,
+    )
+    progress.stop()
+    return base_state(change, coupling), _parse_warnings(files)
+
+
+def _parse_warnings(files: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+    seen: dict[str, ParseWarning] = {}
+    for facts in files:
+        for warning in facts.warnings:
+            seen.setdefault(str(warning), warning)
+    return tuple(seen.values())
+
+
+def _planned(plan: Plan, architecture: Architecture, context: _Context) -> list[ChangeReport]:
+    request = context.request
+    roles = rule_roles(rule_set(request.settings, context.root))
+    return apply_stages(
+        plan.source,
+        context.state,
+        [s for s in architecture.stages],
+        location_rules(request),
+        roles,
+        dynamic_pre_zero=request.dynamic_pre_zero,
+    )
+
+
+def _sketch_snapshot(plan: Plan, sketch: Sketch, before: Snapshot, context: _Context) -> Snapshot:
+    """The tree a sketch stands for: a revision, or the tree before with a patch or stubs."""
+    folder = Path(plan.source).parent
+    try:
+        if sketch.kind is SketchKind.REVISION:
+            git.resolve(context.repo, sketch.value)
+            return open_snapshot(context.root, sketch.value)
+        path = _inside(plan, sketch, folder)
+        if sketch.kind is SketchKind.PATCH:
+            return patch_overlay(before, path, f"{sketch.value} on {before.label}")
+        return stubs_overlay(before, path, f"{sketch.value} on {before.label}")
+    except SourceError as error:
+        raise PlanError(plan.source, sketch.key, str(error)) from None
+
+
+def _inside(plan: Plan, sketch: Sketch, folder: Path) -> Path:
+    """A sketch's patch file or stub folder: relative to the plan's folder, and inside it."""
+    given = Path(sketch.value)
+    resolved = (folder / given).resolve()
+    if given.is_absolute() or not resolved.is_relative_to(folder.resolve()):
+        raise PlanError(plan.source, sketch.key, "must be a path inside the plan's folder")
+    return resolved
+
+
+def _sketched(
+    plan: Plan, architecture: Architecture, context: _Context
+) -> list[tuple[ChangeReport, tuple[ParseWarning, ...]]]:
+    results = []
+    before: Snapshot = context.base
+    spec: str | None = context.request.base  # None once a patch or stubs made the tree
+    for stage in architecture.stages:
+        assert stage.sketch is not None
+        after = _sketch_snapshot(plan, stage.sketch, before, context)
+        renames: dict[str, str] = {}
+        if stage.sketch.kind is SketchKind.REVISION:
+            if spec is not None:
+                renames = git.renames(context.repo, spec, stage.sketch.value)
+            spec = stage.sketch.value
+        else:
+            spec = None
+        pair = (before, after)
+        results.append(
+            measure_snapshots(
+                context.request, context.root, pair, renames, context.progress, context.cache
+            )
+        )
+        before = after
+    return results
+
+
+def _kind(plan: Plan, architecture: Architecture) -> str:
+    sketches = [s.sketch for s in architecture.stages if s.sketch is not None]
+    if not sketches:
+        return "plan"
+    if len(sketches) != len(architecture.stages):
+        raise PlanError(
+            plan.source,
+            architecture.key,
+            "mixes planned and sketched stages: a sketch is measured against the code"
+            " before it, which a planned stage does not leave",
+        )
+    return "sketch:" + ",".join(dict.fromkeys(s.kind.value for s in sketches))
+
+
+def _estimate(
+    plan: Plan, architecture: Architecture, context: _Context, gates: Sequence[Gate]
+) -> tuple[ArchitectureEstimate, list[EstimateFailure]]:
+    kind = _kind(plan, architecture)
+    if kind == "plan":
+        found = [(r, context.warnings) for r in _planned(plan, architecture, context)]
+    else:
+        found = _sketched(plan, architecture, context)
+    stages, failures = [], []
+    texts = tuple(g.text for g in gates)
+    for stage, (change, warnings) in zip(architecture.stages, found, strict=True):
+        head = f"{architecture.name}/{stage.label} (estimate)"
+        report = DiffReport(context.request.base, head, change, warnings, texts)
+        failed = check_gates(gates, report.summaries())
+        stages.append(Stage(stage.label, replace(report, failures=failed)))
+        failures += [EstimateFailure(architecture.name, stage.label, f) for f in failed]
+    series = SeriesReport(str(context.root), tuple(stages))
+    return ArchitectureEstimate(architecture.name, kind, series, architecture.description), failures
+
+
+def run_estimate(
+    request: EstimateRequest, progress: Progress | None = None, cache: FactsCache | None = None
+) -> EstimateReport:
+    """Read the plan, measure the base, estimate every architecture, check the gates."""
+    gates = gates_of(request.diff)  # a bad gate or plan fails before any work
+    plan = read_plan_file(request.plan)
+    progress = progress or NoProgress()
+    progress.phase(f"reading {request.diff.base}")
+    repo = git.open_repository(request.diff.root)
+    root = git.toplevel(repo)
+    base = open_snapshot(root, request.diff.base)
+    state, warnings = measure_base(request.diff, root, base, progress, cache)
+    context = _Context(request.diff, root, repo, base, state, warnings, progress, cache)
+    estimates, failures = [], []
+    for architecture in plan.architectures:
+        estimate, failed = _estimate(plan, architecture, context, gates)
+        estimates.append(estimate)
+        failures += failed
+    progress.stop()
+    return EstimateReport(
+        plan.source,
+        request.diff.base,
+        tuple(estimates),
+        tuple(g.text for g in gates),
+        tuple(failures),
+    )

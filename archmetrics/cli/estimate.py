@@ -1,0 +1,22 @@
+"""The ``estimate`` command: an integration plan priced against a measured base (p. 109)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from archmetrics.app.estimate import EstimateRequest, run_estimate
+from archmetrics.cli.common import emit, facts_cache, gate_status, shown_progress
+from archmetrics.cli.measure import diff_request
+from archmetrics.reports.formats import OutputFormat, render_estimate
+
+
+def estimate_command(args: argparse.Namespace) -> int:
+    fmt = OutputFormat(args.format)
+    request = EstimateRequest(Path(args.plan), diff_request(args, args.repo, args.base, ""))
+    with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
+        report = run_estimate(request, p, cache)
+        p.phase("writing the report")
+        text = render_estimate(report, fmt)
+    emit(text, args.output)
+    return gate_status(report.failures, args)

@@ -1,0 +1,71 @@
+"""The rows every estimate format shows: per-location figures with one column group per
+architecture, the changed elements of each, and the ranking (table, Markdown and CSV agree)."""
+
+from __future__ import annotations
+
+from archmetrics.reports.diff_rows import SUMMARY_ROWS, element_row, number
+from archmetrics.reports.model import LOCATION_COLUMNS, EstimateReport, Stage
+
+RANKING_HEADER = ("stage", "rank", "architecture", "E", "Γ'", "ΔVg'")
+LABEL = "estimate, not a measurement of the integration"
+
+
+def stages_named(report: EstimateReport, label: str) -> list[tuple[str, str, Stage]]:
+    """(architecture, kind, stage) for every architecture that has a stage ``label``."""
+    return [
+        (a.name, a.kind, s)
+        for a in report.architectures
+        for s in a.series.stages
+        if s.label == label
+    ]
+
+
+def summary_header(report: EstimateReport, label: str) -> list[str]:
+    """``metric``, ``eq.``, then ``ARCH base`` ... ``ARCH total`` for every architecture."""
+    names = [name for name, _, _ in stages_named(report, label)]
+    return ["metric", "eq.", *(f"{name} {column}" for name in names for column in LOCATION_COLUMNS)]
+
+
+def summary_rows(report: EstimateReport, label: str) -> list[list[str]]:
+    """The diff's per-location rows (thesis tables C-I), one column group per architecture."""
+    found = [s.report.summaries() for _, _, s in stages_named(report, label)]
+    return [
+        [
+            text,
+            eq,
+            *(number(getattr(s[column], field)) for s in found for column in LOCATION_COLUMNS),
+        ]
+        for field, text, eq in SUMMARY_ROWS
+    ]
+
+
+def element_rows(report: EstimateReport, label: str) -> list[list[str]]:
+    """Each architecture's changed elements (the diff's element columns), named by it."""
+    return [
+        [name, *element_row(e)]
+        for name, _, stage in stages_named(report, label)
+        for e in stage.report.change.elements
+        if e.status.value != "unchanged"
+    ]
+
+
+def ranking_rows(report: EstimateReport) -> list[list[str]]:
+    return [
+        [
+            r.stage,
+            str(r.rank),
+            r.architecture,
+            *(number(v) for v in (r.cost, r.scaled_changes, r.scaled_delta_vg)),
+        ]
+        for r in report.ranking()
+    ]
+
+
+def notes(report: EstimateReport, label: str) -> list[str]:
+    """Every note of a stage once, prefixed with the architecture and locations it is of."""
+    where: dict[str, list[str]] = {}
+    for name, _, stage in stages_named(report, label):
+        for column, summary in stage.report.summaries().items():
+            for note in summary.notes:
+                where.setdefault(note, []).append(f"{name} {column}")
+    return [f"[{', '.join(cols)}] {note}" for note, cols in where.items()]

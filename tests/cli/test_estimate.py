@@ -1,0 +1,334 @@
+"""`archmetrics estimate` end to end on real repositories.
+
+The plan's architecture ``planned`` states exactly what the sketch commit does to the base
+(8 statements added, 1 modified, a function with one decision, two imports, a connect and a
+send to the server's port); its estimate must equal the measured diff, and so must the same
+change given as a revision, a patch and a folder of stubs.
+"""
+
+from __future__ import annotations
+
+import json
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from archmetrics.cli import main
+from tests.gitrepo import GitRepo
+
+SERVER = """\
+import socket
+
+PORT = 5555
+
+
+def serve():
+    s = socket.socket()
+    s.bind(("", PORT))
+    s.listen(1)
+    conn, _ = s.accept()
+    data = conn.recv(1024)
+    return data
+"""
+MAIN_V1 = """\
+def run(n):
+    total = 0
+    for i in range(n):
+        total = total + i
+    return total
+"""
+MAIN_V2 = """\
+import socket
+
+from wdb import store
+
+
+def run(n):
+    total = 0
+    for i in range(n):
+        total = total + i * 2
+    return total
+
+
+def report(total):
+    if total > 10:
+        s = socket.socket()
+        s.connect(("localhost", 5555))
+        s.send(b"big")
+    return store.put({}, "total", total)
+"""
+STORE = "def put(db, key, value):\n    db[key] = value\n    return db\n"
+EXACT = """\
+[[architecture.planned.element]]
+name = "app/main.py"
+statements_added = 8
+statements_modified = 1
+functions_added = 1
+decisions_added = 1
+static_dependencies = ["socket", "wdb/store.py"]
+dynamic_links = [
+  { rule = "posix-sockets/py-connect", to = "app/server.py" },
+  { rule = "posix-sockets/py-send", to = "app/server.py" },
+]
+"""
+NUMBERS = (
+    "delta_s_a",
+    "delta_s_e",
+    "delta_d_a",
+    "delta_d_e",
+    "loc_pre",
+    "loc_post",
+    "loc_scale",
+    "added",
+    "removed",
+    "modified",
+    "changes",
+    "scaled_changes",
+    "vg_pre",
+    "vg_post",
+    "vg_scale",
+    "delta_vg",
+    "scaled_delta_vg",
+    "cost",
+)
+
+
+@pytest.fixture
+def sketched(repo: GitRepo) -> GitRepo:
+    """``base``: a server, a loop, a store; ``sketch``: the loop's client reports to both."""
+    files = {"app/server.py": SERVER, "app/main.py": MAIN_V1, "wdb/store.py": STORE}
+    repo.commit("base", tag="base", files=files)
+    repo.git("checkout", "-q", "-b", "sketch")
+    repo.commit("sketch", tag="sketch", files={"app/main.py": MAIN_V2})
+    repo.git("checkout", "-q", "main")
+    return repo
+
+
+def write_plan(folder: Path, text: str, name: str = "plan.toml") -> Path:
+    path = folder / name
+    path.write_text(textwrap.dedent(text), encoding="utf-8")
+    return path
+
+
+def run(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str], *argv: str, status: int = 0
+) -> tuple[str, str]:
+    code = main(["estimate", "-C", str(repo.root), "--new", "wdb/**", *argv])
+    out, err = capsys.readouterr()
+    assert code == status, err
+    return out, err
+
+
+def estimate(repo: GitRepo, capsys: pytest.CaptureFixture[str], plan: Path, *argv: str) -> Any:
+    out, _ = run(repo, capsys, str(plan), "--base", "base", "--format", "json", *argv)
+    return json.loads(out)
+
+
+def measured(repo: GitRepo, capsys: pytest.CaptureFixture[str]) -> Any:
+    argv = ["diff", "-C", str(repo.root), "--new", "wdb/**", "--base", "base"]
+    assert main([*argv, "--head", "sketch", "--format", "json"]) == 0
+    return json.loads(capsys.readouterr()[0])
+
+
+def numbers(locations: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    return {name: {f: summary[f] for f in NUMBERS} for name, summary in locations.items()}
+
+
+def locations_of(document: Any, architecture: str, stage: int = 0) -> dict[str, Any]:
+    return document["architectures"][architecture]["stages"][stage]["locations"]  # type: ignore[no-any-return]
+
+
+def test_a_plan_that_states_what_the_sketch_does_estimates_the_measured_diff(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path, EXACT + '\n[architecture.sketched]\nsketch = { revision = "sketch" }\n'
+    )
+    document = estimate(sketched, capsys, plan)
+    diff = measured(sketched, capsys)
+    assert document["schema"] == "archmetrics.estimate/1" and document["estimate"] is True
+    assert numbers(locations_of(document, "planned")) == numbers(diff["locations"])
+    assert numbers(locations_of(document, "sketched")) == numbers(diff["locations"])
+    assert document["architectures"]["planned"]["kind"] == "plan"
+    assert document["architectures"]["sketched"]["kind"] == "sketch:revision"
+    # per element too: Γ counts and λ, v_g and coupling after
+    planned = {
+        e["element"]: e for e in document["architectures"]["planned"]["stages"][0]["elements"]
+    }
+    for element in diff["elements"]:
+        mine = planned[element["element"]]
+        for field in ("location", "status", "added", "removed", "modified"):
+            assert mine[field] == element[field], (element["element"], field)
+        for field in ("loc", "vg", "s_a", "s_e", "d_a", "d_e"):
+            assert mine["post"][field] == element["post"][field], (element["element"], field)
+    notes = locations_of(document, "planned")["total"]["notes"]
+    assert any(n.startswith("estimate_from_plan:") for n in notes)
+
+
+def test_a_patch_and_a_folder_of_stubs_are_measured_as_the_revision_is(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "sketch.patch").write_text(sketched.git("diff", "base", "sketch"), encoding="utf-8")
+    stubs = tmp_path / "stubs" / "app"
+    stubs.mkdir(parents=True)
+    (stubs / "main.py").write_text(MAIN_V2, encoding="utf-8")
+    plan = write_plan(
+        tmp_path,
+        """\
+        [architecture.revision]
+        sketch = { revision = "sketch" }
+        [architecture.patch]
+        sketch = { patch = "sketch.patch" }
+        [architecture.stubs]
+        sketch = { stubs = "stubs" }
+        """,
+    )
+    document = estimate(sketched, capsys, plan)
+    revision = numbers(locations_of(document, "revision"))
+    assert numbers(locations_of(document, "patch")) == revision
+    assert numbers(locations_of(document, "stubs")) == revision
+    assert document["architectures"]["patch"]["kind"] == "sketch:patch"
+    assert sketched.status() == ""  # the repository is left as it was
+
+
+def test_the_ranking_puts_the_cheapest_total_cost_first(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path,
+        EXACT
+        + """
+        [[architecture.lean.element]]
+        name = "app/main.py"
+        statements_added = 2
+        functions_added = 1
+        """,
+    )
+    document = estimate(sketched, capsys, plan)
+    ranking = [(r["rank"], r["architecture"]) for r in document["ranking"]]
+    costs = {n: locations_of(document, n)["total"]["cost"] for n in ("planned", "lean")}
+    expected = sorted(costs, key=lambda n: costs[n])
+    assert ranking == [(1, expected[0]), (2, expected[1])]
+    # lean by hand: λ 17 -> 19, Γ = 2, Vg 4 -> 5: Γ' = 19/17·2, ΔVg' = 5/4·1
+    assert costs["lean"] == pytest.approx((19 / 17 * 2) / (5 / 4 * 1))
+
+
+def test_every_format_shows_each_architecture_and_says_it_is_an_estimate(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path, EXACT + '\n[architecture.sketched]\nsketch = { revision = "sketch" }\n'
+    )
+    table, _ = run(sketched, capsys, str(plan), "--base", "base")
+    assert "estimate" in table and "planned total" in table and "sketched total" in table
+    assert "ranking" in table
+    markdown, _ = run(sketched, capsys, str(plan), "--base", "base", "--format", "markdown")
+    assert "estimate, not a measurement" in markdown and "| planned base |" in markdown
+    csv, _ = run(sketched, capsys, str(plan), "--base", "base", "--format", "csv")
+    header, *rows = csv.splitlines()
+    assert header.startswith("architecture,stage,row,name,location")
+    assert {r.split(",")[0] for r in rows} == {"planned", "sketched"}
+
+
+def test_a_gate_fails_on_the_architecture_that_exceeds_it(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path,
+        EXACT + '\n[[architecture.tiny.element]]\nname = "wdb/store.py"\nstatements_modified = 1\n',
+    )
+    argv = [str(plan), "--base", "base", "--fail-on", "changes > 5", "--format", "json"]
+    out, err = run(sketched, capsys, *argv, status=1)
+    assert json.loads(out)["failures"] == [
+        {"architecture": "planned", "stage": "estimate", "gate": "changes > 5"}
+    ]
+    assert "planned (estimate): gate failed: changes > 5 (changes(total) = 9)" in err
+    codeclimate, _ = run(sketched, capsys, str(plan), "--base", "base", "--fail-on", "changes > 5",
+                         "--format", "codeclimate", status=1)  # fmt: skip
+    assert [i["description"].split(":")[0] for i in json.loads(codeclimate)] == ["planned estimate"]
+
+
+BAD_PLANS = [
+    (
+        '[[architecture.a.element]]\nname = "app/nope.py"\nstatements_added = 1\n',
+        "architecture.a.element[0].name: unknown element 'app/nope.py'",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\nstatements_added = -3\n',
+        "architecture.a.element[0].statements_added: must be an integer >= 0",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\n'
+        'dynamic_links = [{ rule = "carrier-pigeon" }]\n',
+        "architecture.a.element[0].dynamic_links[0].rule: unknown rule 'carrier-pigeon'",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\nlocation = "moon"\n',
+        "architecture.a.element[0].location: unknown location 'moon'",
+    ),
+    ('[architecture.a\nname = "x"\n', "not valid TOML"),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\n'
+        '[[architecture.a.element]]\nname = "app/main.py"\n',
+        "architecture.a.element[1].name: element 'app/main.py' is also architecture.a.element[0]",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\n'
+        'dynamic_links = [{ rule = "posix-sockets/py-recv", to = "app/server.py" }]\n',
+        "architecture.a.element[0].dynamic_links[0].to: rule 'posix-sockets/py-recv' has role",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\nstatements_removed = 6\n',
+        "architecture.a.element[0].statements_removed: removes and modifies 6 statements",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/new.py"\nnew = true\n'
+        'static_dependencies = ["app/missing.py"]\n'
+        '[[architecture.a.element]]\nname = "app/main.py"\n'
+        'dynamic_links = [{ rule = "posix-sockets/py-send", to = "app/ghost.py" }]\n',
+        "architecture.a.element[1].dynamic_links[0].to: unknown element 'app/ghost.py'",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\nnew = true\n',
+        "architecture.a.element[0].name: element 'app/main.py' already exists",
+    ),
+    (
+        '[architecture.a]\nsketch = { patch = "../../etc/passwd" }\n',
+        "architecture.a.sketch.patch: must be a path inside",
+    ),
+    (
+        '[architecture.a]\nsketch = { revision = "no-such-rev" }\n',
+        "architecture.a.sketch.revision: unknown revision",
+    ),
+    (
+        '[[architecture.a.element]]\nname = "app/main.py"\nlines = 3\n',
+        "architecture.a.element[0].lines: unknown key",
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "expected"), BAD_PLANS)
+def test_a_bad_plan_is_a_one_line_error_naming_the_file_and_the_key(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, expected: str
+) -> None:
+    plan = tmp_path / "sub" / "bad.toml"
+    plan.parent.mkdir()
+    plan.write_text(text, encoding="utf-8")
+    out, err = run(sketched, capsys, str(plan), "--base", "base", status=2)
+    assert out == ""
+    assert err.count("\n") == 1
+    assert err.startswith(f"archmetrics: error: {plan}: ")
+    assert expected in err
+
+
+def test_a_plan_file_too_large_or_missing_is_refused_before_any_work(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    big = tmp_path / "big.toml"
+    big.write_bytes(b"#" * 1_000_001)
+    _, err = run(sketched, capsys, str(big), status=2)
+    assert f"{big}: a plan may hold at most 1000000 bytes" in err
+    _, err = run(sketched, capsys, str(tmp_path / "none.toml"), status=2)
+    assert f"{tmp_path / 'none.toml'}: cannot read" in err
