@@ -18,12 +18,14 @@ from archmetrics.app.diff import (
     DiffRequest,
     gates_of,
     location_rules,
+    measure_change,
     measure_snapshots,
     parse_side,
     site_memo,
 )
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset import ChangeReport, FilePair, compute_change, coupling_by_element
+from archmetrics.changeset.accuracy import compare_change
 from archmetrics.changeset.estimate import BaseState, apply_stages, base_state, rule_roles
 from archmetrics.changeset.gates import Gate, check_gates
 from archmetrics.changeset.plan import Architecture, Plan, PlanError, Sketch, SketchKind
@@ -55,6 +57,8 @@ class EstimateRequest:
 
     plan: Path
     diff: DiffRequest
+    actual: str | None = None  # --actual --head REV: compare with the measured base..REV
+    stage: str | None = None  # --stage: which stage --actual compares (default: the only one)
 
 
 def read_plan_file(path: Path) -> Plan:
@@ -127,6 +131,7 @@ def _parse_warnings(files: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
 
 
 def _planned(plan: Plan, architecture: Architecture, context: _Context) -> list[ChangeReport]:
+    """Each planned stage applied to what the one before left, the first to the base."""
     request = context.request
     roles = rule_roles(rule_set(request.settings, context.root))
     return apply_stages(
@@ -223,12 +228,33 @@ def _estimate(
     return ArchitectureEstimate(architecture.name, kind, series, architecture.description), failures
 
 
+def _one_stage(plan: Plan, architecture: Architecture, label: str | None) -> Architecture:
+    """The stage ``--actual`` compares, alone: estimated from the base it is compared from."""
+    if label is None:
+        if len(architecture.stages) > 1:
+            labels = ", ".join(s.label for s in architecture.stages)
+            raise PlanError(
+                plan.source,
+                architecture.key,
+                f"has stages {labels}: --stage names the one --actual compares",
+            )
+        return architecture
+    for stage in architecture.stages:
+        if stage.label == label:
+            return replace(architecture, stages=(stage,))
+    raise PlanError(plan.source, architecture.key, f"has no stage {label!r} (--stage)")
+
+
 def run_estimate(
     request: EstimateRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> EstimateReport:
-    """Read the plan, measure the base, estimate every architecture, check the gates."""
+    """Read the plan, measure the base, estimate every architecture, check the gates; with
+    ``actual``, measure base..actual too and the error of every estimated figure."""
     gates = gates_of(request.diff)  # a bad gate or plan fails before any work
     plan = read_plan_file(request.plan)
+    if request.actual is not None:
+        chosen = tuple(_one_stage(plan, a, request.stage) for a in plan.architectures)
+        plan = replace(plan, architectures=chosen)
     progress = progress or NoProgress()
     progress.phase(f"reading {request.diff.base}")
     repo = git.open_repository(request.diff.root)
@@ -241,11 +267,30 @@ def run_estimate(
         estimate, failed = _estimate(plan, architecture, context, gates)
         estimates.append(estimate)
         failures += failed
-    progress.stop()
-    return EstimateReport(
+    report = EstimateReport(
         plan.source,
         request.diff.base,
         tuple(estimates),
         tuple(g.text for g in gates),
         tuple(failures),
     )
+    if request.actual is not None:
+        report = _with_actual(report, replace(request.diff, head=request.actual), progress, cache)
+    progress.stop()
+    return report
+
+
+def _with_actual(
+    report: EstimateReport,
+    request: DiffRequest,
+    progress: Progress,
+    cache: FactsCache | None,
+) -> EstimateReport:
+    """The report with the measured change and each architecture's errors against it."""
+    change, warnings = measure_change(request, progress, cache)
+    actual = DiffReport(request.base, request.head, change, warnings)
+    accuracy = tuple(
+        (a.name, compare_change(a.series.stages[0].report.change, change))
+        for a in report.architectures
+    )
+    return replace(report, actual=actual, accuracy=accuracy)

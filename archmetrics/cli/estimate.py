@@ -6,14 +6,23 @@ import argparse
 from pathlib import Path
 
 from archmetrics.app.estimate import EstimateRequest, run_estimate
-from archmetrics.cli.common import emit, facts_cache, gate_status, shown_progress
+from archmetrics.cli.common import UsageError, emit, facts_cache, gate_status, shown_progress
 from archmetrics.cli.measure import diff_request
 from archmetrics.reports.formats import OutputFormat, render_estimate
 
 
 def estimate_command(args: argparse.Namespace) -> int:
     fmt = OutputFormat(args.format)
-    request = EstimateRequest(Path(args.plan), diff_request(args, args.repo, args.base, ""))
+    if not args.actual and (args.head is not None or args.stage is not None):
+        raise UsageError("--head and --stage go with --actual")
+    if args.actual and args.head is None:
+        raise UsageError("--actual needs --head: the revision the integration was done in")
+    request = EstimateRequest(
+        Path(args.plan),
+        diff_request(args, args.repo, args.base, ""),
+        args.head if args.actual else None,
+        args.stage,
+    )
     with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
         report = run_estimate(request, p, cache)
         p.phase("writing the report")

@@ -193,6 +193,16 @@ def build_parser() -> argparse.ArgumentParser:
         "--base", default="HEAD", help="the revision the plan applies to (default HEAD)"
     )
     estimate.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    estimate.add_argument(
+        "--actual",
+        action="store_true",
+        help="after the integration: compare the estimate with the measured --base..--head,"
+        " per location and per element, and report each figure's error",
+    )
+    estimate.add_argument("--head", help="with --actual: the revision the integration is in")
+    estimate.add_argument(
+        "--stage", help="with --actual: the stage to compare (default: the plan's only stage)"
+    )
     add_locations(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
     replicate = commands.add_parser(

@@ -6,7 +6,14 @@ from __future__ import annotations
 import csv
 import io
 
-from archmetrics.reports.frames import Table, diff_table, estimate_table, scan_table, trend_table
+from archmetrics.reports.frames import (
+    Table,
+    accuracy_table,
+    diff_table,
+    estimate_table,
+    scan_table,
+    trend_table,
+)
 from archmetrics.reports.model import (
     CompareReport,
     DiffReport,
@@ -46,5 +53,5 @@ def render_compare(report: CompareReport) -> str:
 
 def render_estimate(report: EstimateReport) -> str:
     """The diff's rows (a row per location, then per element) for every architecture and
-    stage, named in the first two columns."""
-    return _csv(estimate_table(report))
+    stage, named in the first two columns; with --actual, each figure's error instead."""
+    return _csv(estimate_table(report) if report.actual is None else accuracy_table(report))

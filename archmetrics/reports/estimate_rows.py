@@ -3,6 +3,7 @@ architecture, the changed elements of each, and the ranking (table, Markdown and
 
 from __future__ import annotations
 
+from archmetrics.changeset.accuracy import FigureError
 from archmetrics.reports.diff_rows import SUMMARY_ROWS, element_row, number
 from archmetrics.reports.model import LOCATION_COLUMNS, EstimateReport, Stage
 
@@ -69,3 +70,64 @@ def notes(report: EstimateReport, label: str) -> list[str]:
             for note in summary.notes:
                 where.setdefault(note, []).append(f"{name} {column}")
     return [f"[{', '.join(cols)}] {note}" for note, cols in where.items()]
+
+
+# --actual: the figures a table or Markdown shows per location (JSON and CSV have them all)
+ACCURACY_FIGURES: tuple[tuple[str, str], ...] = (
+    ("changes", "Γ"),
+    ("scaled_changes", "Γ'"),
+    ("delta_vg", "ΔVg"),
+    ("scaled_delta_vg", "ΔVg'"),
+    ("cost", "E"),
+    ("loc_post", "λ_post"),
+    ("vg_post", "Vg_post"),
+    ("delta_s_a", "Δs_a"),
+    ("delta_s_e", "Δs_e"),
+    ("delta_d_a", "Δd_a"),
+    ("delta_d_e", "Δd_e"),
+)
+ACCURACY_HEADER = ("architecture", "location", "figure", "estimated", "actual", "error", "error %")
+ELEMENT_ACCURACY_HEADER = (
+    "architecture",
+    "element",
+    "location",
+    "figure",
+    "estimated",
+    "actual",
+    "error",
+    "error %",
+)
+
+
+def _percent(value: float | None) -> str:
+    return "n/a" if value is None else f"{100 * value:+.0f}%"
+
+
+def _cells(figure: FigureError) -> list[str]:
+    return [
+        number(figure.estimated),
+        number(figure.actual),
+        number(figure.error),
+        _percent(figure.relative),
+    ]
+
+
+def accuracy_rows(report: EstimateReport) -> list[list[str]]:
+    """Per architecture and location (total last), the main figures against the measured."""
+    rows = []
+    for name, accuracy in report.accuracy:
+        for place in accuracy.locations:
+            for field, label in ACCURACY_FIGURES:
+                rows.append([name, place.name, label, *_cells(place.figure(field))])
+    return rows
+
+
+def element_accuracy_rows(report: EstimateReport) -> list[list[str]]:
+    """Per architecture, each element's figures that the estimate got wrong."""
+    return [
+        [name, element.name, element.location, figure.figure, *_cells(figure)]
+        for name, accuracy in report.accuracy
+        for element in accuracy.elements
+        for figure in element.figures
+        if figure.error != 0
+    ]

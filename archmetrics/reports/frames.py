@@ -124,3 +124,19 @@ def estimate_table(report: EstimateReport) -> Table:
             columns = ("architecture", "stage", *table.columns)
             rows += [(architecture.name, stage.label, *row) for row in table.rows]
     return Table(columns, rows)
+
+
+def accuracy_table(report: EstimateReport) -> Table:
+    """--actual: a row per architecture, location or element, and figure: estimated,
+    measured, error (estimated − measured) and relative error (error / |measured|)."""
+    rows: list[tuple[Cell, ...]] = []
+    for name, accuracy in report.accuracy:
+        for scope, places in (("location", accuracy.locations), ("element", accuracy.elements)):
+            for place in places:
+                for f in place.figures:
+                    rows.append(
+                        (name, scope, place.name, place.location, f.figure, f.estimated,
+                         f.actual, f.error, f.relative)
+                    )  # fmt: skip
+    columns = ("architecture", "row", "name", "location", "figure", "estimated", "actual")
+    return Table((*columns, "error", "relative"), rows)

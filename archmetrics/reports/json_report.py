@@ -6,6 +6,7 @@ import json
 import re
 from typing import Any
 
+from archmetrics.changeset.accuracy import Accuracy
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
@@ -189,5 +190,38 @@ def estimate_dict(report: EstimateReport) -> dict[str, Any]:
     }
 
 
+def _figures(place: Accuracy) -> dict[str, Any]:
+    return {
+        f.figure: {
+            "estimated": f.estimated,
+            "actual": f.actual,
+            "error": f.error,
+            "relative": f.relative,
+        }
+        for f in place.figures
+    }
+
+
+def accuracy_dict(report: EstimateReport) -> dict[str, Any]:
+    """--actual: the measured change, and per architecture every figure's error."""
+    assert report.actual is not None
+    actual = diff_dict(report.actual)
+    del actual["schema"]
+    accuracy = {
+        name: {
+            "locations": {place.name: _figures(place) for place in found.locations},
+            "elements": [
+                {"element": e.name, "location": e.location, "figures": _figures(e)}
+                for e in found.elements
+            ],
+        }
+        for name, found in report.accuracy
+    }
+    return {"actual": actual, "accuracy": accuracy}
+
+
 def render_estimate(report: EstimateReport) -> str:
-    return dumps(estimate_dict(report))
+    document = estimate_dict(report)
+    if report.actual is not None:
+        document.update(accuracy_dict(report))
+    return dumps(document)

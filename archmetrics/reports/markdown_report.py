@@ -182,6 +182,17 @@ def render_estimate(report: EstimateReport) -> str:
             parts.append(table(element_header, rows, "llll" + "r" * (len(element_header) - 4)))
     parts.append("### Ranking: cheapest total E first\n")
     parts.append(table(estimate_rows.RANKING_HEADER, estimate_rows.ranking_rows(report), "lrlrrr"))
+    if report.actual is not None:
+        parts.append(
+            f"### Accuracy: the estimate against the measured "
+            f"`{report.actual.base}` → `{report.actual.head}`\n"
+        )
+        rows = estimate_rows.accuracy_rows(report)
+        parts.append(table(estimate_rows.ACCURACY_HEADER, rows, "lllrrrr"))
+        elements = estimate_rows.element_accuracy_rows(report)
+        if elements:
+            parts.append("#### Elements: the figures the estimate got wrong\n")
+            parts.append(table(estimate_rows.ELEMENT_ACCURACY_HEADER, elements, "llllrrrr"))
     bullets = [f"- {f}" for f in report.failures]
     bullets += [
         f"- note {n}" for label in report.stage_labels() for n in estimate_rows.notes(report, label)

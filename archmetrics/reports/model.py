@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from archmetrics.changeset.accuracy import ChangeAccuracy
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
@@ -166,6 +167,8 @@ class EstimateReport:
     architectures: tuple[ArchitectureEstimate, ...]
     gates: tuple[str, ...] = ()
     failures: tuple[EstimateFailure, ...] = ()
+    actual: DiffReport | None = None  # --actual: the change measured afterwards
+    accuracy: tuple[tuple[str, ChangeAccuracy], ...] = ()  # per architecture, against it
 
     def compare(self) -> CompareReport:
         """The architectures as series side by side (what series and compare render)."""

@@ -198,8 +198,25 @@ def render_estimate(report: EstimateReport, color: bool = False) -> str:
     parts.append(
         rows_table("ranking: cheapest total E first", estimate_rows.RANKING_HEADER, ranking, 3)
     )
+    parts += accuracy_parts(report)
     lines = [
         f"note {n}" for label in report.stage_labels() for n in estimate_rows.notes(report, label)
     ]
     lines += [str(f) for f in report.failures]
     return to_text(*parts, color=color) + "".join(line + "\n" for line in lines)
+
+
+def accuracy_parts(report: EstimateReport) -> list[object]:
+    """--actual: each architecture's figures against the measured change."""
+    if report.actual is None:
+        return []
+    title = (
+        f"accuracy: the estimate against the measured {report.actual.base} → {report.actual.head}"
+    )
+    rows = estimate_rows.accuracy_rows(report)
+    parts: list[object] = [rows_table(title, estimate_rows.ACCURACY_HEADER, rows, 3)]
+    elements = estimate_rows.element_accuracy_rows(report)
+    if elements:
+        title = "elements: the figures the estimate got wrong"
+        parts.append(rows_table(title, estimate_rows.ELEMENT_ACCURACY_HEADER, elements, 4))
+    return parts

@@ -332,3 +332,144 @@ def test_a_plan_file_too_large_or_missing_is_refused_before_any_work(
     assert f"{big}: a plan may hold at most 1000000 bytes" in err
     _, err = run(sketched, capsys, str(tmp_path / "none.toml"), status=2)
     assert f"{tmp_path / 'none.toml'}: cannot read" in err
+
+
+GUESS = """\
+[[architecture.guess.element]]
+name = "app/main.py"
+statements_added = 6
+statements_modified = 2
+functions_added = 1
+decisions_added = 1
+static_dependencies = ["wdb/store.py"]
+dynamic_links = [{ rule = "posix-sockets/py-connect", to = "app/server.py" }]
+"""
+
+
+def test_actual_reports_the_error_of_every_figure_computed_by_hand(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(tmp_path, GUESS)
+    argv = ["--actual", "--head", "sketch"]
+    document = estimate(sketched, capsys, plan, *argv)
+    assert document["actual"]["head"] == "sketch"
+    base = document["accuracy"]["guess"]["locations"]["base"]
+    # the base location holds main.py (λ 5, v_g 2) and server.py (λ 9, v_g 1): λ_pre 14, Vg 3
+    # estimated: Γ = 6 + 2 = 8, λ_post 20; measured: Γ = 8 + 1 = 9, λ_post 22; Vg 3 -> 5 both
+    assert base["changes"] == {"estimated": 8, "actual": 9, "error": -1, "relative": -1 / 9}
+    assert base["loc_post"]["error"] == -2
+    assert base["delta_vg"] == {"estimated": 2, "actual": 2, "error": 0, "relative": 0.0}
+    estimated_cost = (8 * 20 / 14) / (2 * 5 / 3)
+    actual_cost = (9 * 22 / 14) / (2 * 5 / 3)
+    assert base["cost"]["estimated"] == pytest.approx(estimated_cost)
+    assert base["cost"]["actual"] == pytest.approx(actual_cost)
+    assert base["cost"]["error"] == pytest.approx(estimated_cost - actual_cost)
+    assert base["cost"]["relative"] == pytest.approx((estimated_cost - actual_cost) / actual_cost)
+    # one link and one import planned, two of each made: Δs_e, Δd_e and the server's Δd_a
+    for figure in ("delta_s_e", "delta_d_a", "delta_d_e"):
+        assert (base[figure]["estimated"], base[figure]["actual"]) == (1, 2), figure
+    elements = {e["element"]: e["figures"] for e in document["accuracy"]["guess"]["elements"]}
+    main_py = elements["app/main.py"]
+    errors = {f: main_py[f]["error"] for f in ("added", "modified", "loc", "vg", "s_e", "d_e")}
+    assert errors == {"added": -2, "modified": 1, "loc": -2, "vg": 0, "s_e": -1, "d_e": -1}
+    # the server did not change, but the estimate got its d_a wrong: it is listed too
+    assert elements["app/server.py"]["d_a"] == {
+        "estimated": 1,
+        "actual": 2,
+        "error": -1,
+        "relative": -0.5,
+    }
+    assert "wdb/store.py" not in elements  # s_a 0 -> 1 on both sides: right
+    csv, _ = run(sketched, capsys, str(plan), "--base", "base", *argv, "--format", "csv")
+    assert "guess,location,base,base,changes,8,9,-1,-0.111" in csv
+    table, _ = run(sketched, capsys, str(plan), "--base", "base", *argv)
+    assert "accuracy: the estimate against the measured base → sketch" in table
+
+
+def test_actual_compares_the_stage_named_and_wants_a_head(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path,
+        """\
+        [[architecture.a.stage]]
+        label = "first"
+        [[architecture.a.stage.element]]
+        name = "app/main.py"
+        statements_added = 100
+        [[architecture.a.stage]]
+        label = "second"
+        [[architecture.a.stage.element]]
+        name = "app/main.py"
+        statements_added = 8
+        statements_modified = 1
+        """,
+    )
+    _, err = run(sketched, capsys, str(plan), "--actual", "--head", "sketch", status=2)
+    assert f"{plan}: architecture.a: has stages first, second: --stage names the one" in err
+    _, err = run(sketched, capsys, str(plan), "--head", "sketch", status=2)
+    assert "--head and --stage go with --actual" in err
+    _, err = run(sketched, capsys, str(plan), "--actual", status=2)
+    assert "--actual needs --head" in err
+    argv = ["--actual", "--head", "sketch", "--stage", "second"]
+    document = estimate(sketched, capsys, plan, *argv)
+    # the second stage alone, estimated from --base: its Γ is the measured one
+    (stage,) = document["architectures"]["a"]["stages"]
+    assert stage["label"] == "second"
+    assert document["accuracy"]["a"]["locations"]["total"]["changes"]["error"] == 0
+
+
+def test_a_staged_plan_gives_the_series_each_stage_on_the_one_before(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path,
+        """\
+        [[architecture.planned.stage]]
+        label = "first"
+        [[architecture.planned.stage.element]]
+        name = "wdb/query.py"
+        new = true
+        statements_added = 10
+        functions_added = 2
+        [[architecture.planned.stage]]
+        label = "second"
+        [[architecture.planned.stage.element]]
+        name = "wdb/query.py"
+        statements_added = 5
+        decisions_added = 2
+
+        [[architecture.drawn.stage]]
+        label = "first"
+        sketch = { revision = "base" }
+        [[architecture.drawn.stage]]
+        label = "second"
+        sketch = { revision = "sketch" }
+        """,
+    )
+    document = estimate(sketched, capsys, plan)
+    planned = document["architectures"]["planned"]["stages"]
+    assert [s["label"] for s in planned] == ["first", "second"]
+    new = planned[1]["locations"]["new"]
+    # wdb: store (λ 3, v_g 1) and the query planned in stage one (λ 10, v_g 2)
+    assert (new["loc_pre"], new["loc_post"], new["vg_pre"], new["vg_post"]) == (13, 18, 3, 5)
+    assert new["cost"] == pytest.approx((18 / 13 * 5) / (5 / 3 * 2))
+    drawn = document["architectures"]["drawn"]["stages"]
+    assert drawn[0]["locations"]["total"]["changes"] == 0  # base against itself
+    assert numbers(drawn[1]["locations"]) == numbers(measured(sketched, capsys)["locations"])
+    ranks = {(r["stage"], r["architecture"]) for r in document["ranking"]}
+    assert ranks == {(s, a) for s in ("first", "second") for a in ("planned", "drawn")}
+    mixed = write_plan(
+        tmp_path,
+        """\
+        [[architecture.m.stage]]
+        label = "first"
+        sketch = { revision = "sketch" }
+        [[architecture.m.stage]]
+        label = "second"
+        element = []
+        """,
+        "mixed.toml",
+    )
+    _, err = run(sketched, capsys, str(mixed), "--base", "base", status=2)
+    assert "architecture.m: mixes planned and sketched stages" in err
