@@ -10,191 +10,31 @@ E and the coupling deltas use one set of formulas (cost.py). Choices the thesis 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from archmetrics.changeset.compute import report_of, side_notes
 from archmetrics.changeset.elements import Side
 from archmetrics.changeset.locations import Location, LocationRules
-from archmetrics.changeset.model import ChangeReport, ElementChange, ExcludedFile, Metrics, Status
-from archmetrics.changeset.plan import PlanError, PlannedElement, PlannedLink, PlannedStage
-from archmetrics.coupling.model import CouplingReport
-from archmetrics.coupling.rules import Role, RuleSet
+from archmetrics.changeset.model import ChangeReport, ElementChange, Metrics, Status
+from archmetrics.changeset.plan import PlannedElement, PlannedStage
+from archmetrics.changeset.plan_check import Planner, rule_roles
+from archmetrics.changeset.plan_state import BaseState, ElementState, base_state
+from archmetrics.coupling.rules import Role
+
+__all__ = [
+    "ESTIMATE_NOTE",
+    "BaseState",
+    "ElementState",
+    "apply_stage",
+    "apply_stages",
+    "base_state",
+    "rule_roles",
+]
 
 ESTIMATE_NOTE = (
     "estimate_from_plan: Γ, λ_post, Vg_post and the coupling after are planned, not measured"
     " (docs/estimate.md)"
 )
-
-
-@dataclass(frozen=True, slots=True)
-class ElementState:
-    """An element as a stage leaves it: its location, metrics M and static coupling edges."""
-
-    name: str
-    location: Location
-    metrics: Metrics
-    files: tuple[str, ...] = ()
-    dependencies: frozenset[str] = frozenset()  # counted: target elements, external names
-    dependents: frozenset[str] = frozenset()  # the elements behind s_a
-
-
-@dataclass(frozen=True, slots=True)
-class BaseState:
-    """Every element of a tree (measured, or as a planned stage leaves it), by name."""
-
-    elements: tuple[ElementState, ...]
-    excluded: tuple[ExcludedFile, ...] = ()
-
-    def by_name(self) -> dict[str, ElementState]:
-        return {e.name: e for e in self.elements}
-
-
-def base_state(change: ChangeReport, coupling: CouplingReport | None) -> BaseState:
-    """The state of the tree a change report measured after (its ``post`` side), with each
-    element's counted dependencies and dependents from the coupling layer's report."""
-    edges = {c.element.name: c for c in coupling.elements} if coupling else {}
-    states = []
-    for element in change.elements:
-        if element.post is None:
-            continue
-        found = edges.get(element.element)
-        dependencies = frozenset(
-            d.target_element or d.name for d in (found.dependencies if found else ()) if d.counted
-        )
-        dependents = frozenset(found.dependents if found else ())
-        states.append(
-            ElementState(
-                element.element,
-                element.location,
-                element.post,
-                element.files,
-                dependencies,
-                dependents,
-            )
-        )
-    return BaseState(tuple(states), change.excluded)
-
-
-def rule_roles(rules: RuleSet) -> dict[str, Role | None]:
-    """Rule name -> its role, by qualified id (``zeromq/py-send``) and by bare id when only
-    one pack has it (a bare id in two packs maps to None: ambiguous)."""
-    roles: dict[str, Role | None] = {}
-    bare: dict[str, set[Role]] = {}
-    for rule in rules.rules:
-        roles[rule.qualified_id] = rule.role
-        bare.setdefault(rule.id, set()).add(rule.role)
-    for name, found in bare.items():
-        if name not in roles:
-            roles[name] = next(iter(found)) if len(found) == 1 else None
-    return roles
-
-
-class _Planner:
-    """One stage applied to a state: checks every planned element against it, then counts."""
-
-    def __init__(
-        self,
-        source: str,
-        state: BaseState,
-        stage: PlannedStage,
-        rules: LocationRules,
-        roles: Mapping[str, Role | None],
-    ) -> None:
-        self.source, self.state, self.stage, self.roles = source, state, stage, roles
-        self.existing = state.by_name()
-        self.file_owner = {f: e.name for e in state.elements for f in e.files}
-        self.locations: dict[str, Location] = {n: e.location for n, e in self.existing.items()}
-        for planned in stage.elements:
-            self.locations.setdefault(
-                planned.name, planned.location or rules.location_of(planned.name)
-            )
-            self._check(planned)
-
-    def fail(self, key: str, problem: str) -> PlanError:
-        return PlanError(self.source, key, problem)
-
-    def _check(self, planned: PlannedElement) -> None:
-        found = self.existing.get(planned.name)
-        if planned.new:
-            if found is not None:
-                raise self.fail(
-                    f"{planned.key}.name",
-                    f"element {planned.name!r} already exists in the base (drop `new = true`)",
-                )
-            for key, value in (
-                ("statements_removed", planned.removed),
-                ("statements_modified", planned.modified),
-                ("decisions_removed", planned.decisions_removed),
-                ("functions_removed", planned.functions_removed),
-            ):
-                if value:
-                    raise self.fail(
-                        f"{planned.key}.{key}", "a new element has nothing to remove or modify"
-                    )
-            return
-        if found is None:
-            raise self.fail(
-                f"{planned.key}.name",
-                f"unknown element {planned.name!r}: not in the base (`new = true` plans a new one)",
-            )
-        if planned.location is not None and planned.location is not found.location:
-            raise self.fail(
-                f"{planned.key}.location",
-                f"element {planned.name!r} is in {found.location.value} in the base,"
-                f" not {planned.location.value}",
-            )
-        if planned.removed + planned.modified > found.metrics.loc:
-            raise self.fail(
-                f"{planned.key}.statements_removed",
-                f"removes and modifies {planned.removed + planned.modified} statements"
-                f" of an element of λ = {found.metrics.loc}",
-            )
-        if found.metrics.vg + planned.delta_vg < 0:
-            raise self.fail(
-                f"{planned.key}.decisions_removed",
-                f"removes more than the element's v_g = {found.metrics.vg}",
-            )
-
-    def target(self, name: str, key: str) -> str:
-        """The element a dependency or link names: an element, or a file of one."""
-        if name in self.locations:
-            return name
-        owner = self.file_owner.get(name)
-        if owner is None:
-            raise self.fail(
-                key, f"unknown element {name!r}: neither in the base nor new in this stage"
-            )
-        return owner
-
-    def dependency(self, planned: PlannedElement, name: str, key: str) -> str:
-        """An element (or a file of one) is an internal dependency; anything else external."""
-        if name in self.locations or name in self.file_owner:
-            found = self.target(name, key)
-            if found == planned.name:
-                raise self.fail(key, f"element {planned.name!r} cannot depend on itself")
-            return found
-        return name
-
-    def link_target(self, link: PlannedLink) -> str | None:
-        if link.rule not in self.roles:
-            raise self.fail(
-                f"{link.key}.rule",
-                f"unknown rule {link.rule!r} (`archmetrics rules` lists those in force)",
-            )
-        role = self.roles[link.rule]
-        if role is None:
-            raise self.fail(
-                f"{link.key}.rule", f"rule {link.rule!r} is in several packs: name it as pack/rule"
-            )
-        if link.to is None:
-            return None
-        if role is not Role.INITIATE:
-            raise self.fail(
-                f"{link.key}.to",
-                f"rule {link.rule!r} has role {role.value}: only an initiating rule's sites"
-                " count in another element's d_a",
-            )
-        return self.target(link.to, f"{link.key}.to")
 
 
 def apply_stage(
@@ -207,7 +47,7 @@ def apply_stage(
     dynamic_pre_zero: bool = False,
 ) -> tuple[ChangeReport, BaseState]:
     """The change report a planned stage estimates, and the state it leaves for the next."""
-    planner = _Planner(source, state, stage, rules, roles)
+    planner = Planner(source, state, stage, rules, roles)
     notes: list[tuple[Location, str]] = []
     deps = {e.name: set(e.dependencies) for e in state.elements}
     dependents = {e.name: set(e.dependents) for e in state.elements}

@@ -7,11 +7,12 @@ from pathlib import Path
 
 from archmetrics.app.estimate import EstimateRequest, run_estimate
 from archmetrics.cli.common import UsageError, emit, facts_cache, gate_status, shown_progress
-from archmetrics.cli.measure import diff_request
+from archmetrics.cli.measure import check_chart, diff_request, write_chart
 from archmetrics.reports.formats import OutputFormat, render_estimate
 
 
 def estimate_command(args: argparse.Namespace) -> int:
+    check_chart(args)
     fmt = OutputFormat(args.format)
     if not args.actual and (args.head is not None or args.stage is not None):
         raise UsageError("--head and --stage go with --actual")
@@ -28,4 +29,5 @@ def estimate_command(args: argparse.Namespace) -> int:
         p.phase("writing the report")
         text = render_estimate(report, fmt)
     emit(text, args.output)
+    write_chart(args, report.compare())
     return gate_status(report.failures, args)

@@ -204,6 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--stage", help="with --actual: the stage to compare (default: the plan's only stage)"
     )
     add_locations(estimate)
+    add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
