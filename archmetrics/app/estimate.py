@@ -19,16 +19,16 @@ from archmetrics.app.diff import (
     gates_of,
     location_rules,
     measure_change,
-    measure_snapshots,
     parse_side,
     site_memo,
 )
 from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.app.sketch import MeasuredBase, sketched
 from archmetrics.changeset import ChangeReport, FilePair, compute_change, coupling_by_element
 from archmetrics.changeset.accuracy import compare_change
 from archmetrics.changeset.estimate import BaseState, apply_stages, base_state, rule_roles
 from archmetrics.changeset.gates import Gate, check_gates
-from archmetrics.changeset.plan import Architecture, Plan, PlanError, Sketch, SketchKind
+from archmetrics.changeset.plan import Architecture, Plan, PlanError
 from archmetrics.changeset.plan_read import MAX_PLAN_BYTES, read_plan
 from archmetrics.coupling import group_elements, measure_coupling
 from archmetrics.facts import FileFacts, ParseWarning
@@ -42,10 +42,9 @@ from archmetrics.reports.model import (
 )
 from archmetrics.sources import Snapshot, SourceError, git, open_snapshot
 from archmetrics.sources.cache import FactsCache
-from archmetrics.sources.sketch import patch_overlay, stubs_overlay
 
 if TYPE_CHECKING:
-    from git import Repo
+    pass
 
 __all__ = ["EstimateRequest", "measure_base", "read_plan_file", "run_estimate"]
 
@@ -59,6 +58,7 @@ class EstimateRequest:
     diff: DiffRequest
     actual: str | None = None  # --actual --head REV: compare with the measured base..REV
     stage: str | None = None  # --stage: which stage --actual compares (default: the only one)
+    architectures: tuple[str, ...] = ()  # --architecture: only these (default: all)
 
 
 def read_plan_file(path: Path) -> Plan:
@@ -70,20 +70,6 @@ def read_plan_file(path: Path) -> Plan:
     except OSError as error:
         raise PlanError(source, "", f"cannot read: {error.strerror or error}") from None
     return read_plan(data, source)
-
-
-@dataclass(frozen=True, slots=True)
-class _Context:
-    """What every architecture is measured with: the repository, its base and its rules."""
-
-    request: DiffRequest
-    root: Path
-    repo: Repo  # for renames between sketch revisions
-    base: Snapshot
-    state: BaseState
-    warnings: tuple[ParseWarning, ...]
-    progress: Progress
-    cache: FactsCache | None
 
 
 def measure_base(
@@ -130,7 +116,7 @@ def _parse_warnings(files: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
     return tuple(seen.values())
 
 
-def _planned(plan: Plan, architecture: Architecture, context: _Context) -> list[ChangeReport]:
+def _planned(plan: Plan, architecture: Architecture, context: MeasuredBase) -> list[ChangeReport]:
     """Each planned stage applied to what the one before left, the first to the base."""
     request = context.request
     roles = rule_roles(rule_set(request.settings, context.root))
@@ -142,56 +128,6 @@ def _planned(plan: Plan, architecture: Architecture, context: _Context) -> list[
         roles,
         dynamic_pre_zero=request.dynamic_pre_zero,
     )
-
-
-def _sketch_snapshot(plan: Plan, sketch: Sketch, before: Snapshot, context: _Context) -> Snapshot:
-    """The tree a sketch stands for: a revision, or the tree before with a patch or stubs."""
-    folder = Path(plan.source).parent
-    try:
-        if sketch.kind is SketchKind.REVISION:
-            git.resolve(context.repo, sketch.value)
-            return open_snapshot(context.root, sketch.value)
-        path = _inside(plan, sketch, folder)
-        if sketch.kind is SketchKind.PATCH:
-            return patch_overlay(before, path, f"{sketch.value} on {before.label}")
-        return stubs_overlay(before, path, f"{sketch.value} on {before.label}")
-    except SourceError as error:
-        raise PlanError(plan.source, sketch.key, str(error)) from None
-
-
-def _inside(plan: Plan, sketch: Sketch, folder: Path) -> Path:
-    """A sketch's patch file or stub folder: relative to the plan's folder, and inside it."""
-    given = Path(sketch.value)
-    resolved = (folder / given).resolve()
-    if given.is_absolute() or not resolved.is_relative_to(folder.resolve()):
-        raise PlanError(plan.source, sketch.key, "must be a path inside the plan's folder")
-    return resolved
-
-
-def _sketched(
-    plan: Plan, architecture: Architecture, context: _Context
-) -> list[tuple[ChangeReport, tuple[ParseWarning, ...]]]:
-    results = []
-    before: Snapshot = context.base
-    spec: str | None = context.request.base  # None once a patch or stubs made the tree
-    for stage in architecture.stages:
-        assert stage.sketch is not None
-        after = _sketch_snapshot(plan, stage.sketch, before, context)
-        renames: dict[str, str] = {}
-        if stage.sketch.kind is SketchKind.REVISION:
-            if spec is not None:
-                renames = git.renames(context.repo, spec, stage.sketch.value)
-            spec = stage.sketch.value
-        else:
-            spec = None
-        pair = (before, after)
-        results.append(
-            measure_snapshots(
-                context.request, context.root, pair, renames, context.progress, context.cache
-            )
-        )
-        before = after
-    return results
 
 
 def _kind(plan: Plan, architecture: Architecture) -> str:
@@ -209,13 +145,13 @@ def _kind(plan: Plan, architecture: Architecture) -> str:
 
 
 def _estimate(
-    plan: Plan, architecture: Architecture, context: _Context, gates: Sequence[Gate]
+    plan: Plan, architecture: Architecture, context: MeasuredBase, gates: Sequence[Gate]
 ) -> tuple[ArchitectureEstimate, list[EstimateFailure]]:
     kind = _kind(plan, architecture)
     if kind == "plan":
         found = [(r, context.warnings) for r in _planned(plan, architecture, context)]
     else:
-        found = _sketched(plan, architecture, context)
+        found = sketched(plan, architecture, context)
     stages, failures = [], []
     texts = tuple(g.text for g in gates)
     for stage, (change, warnings) in zip(architecture.stages, found, strict=True):
@@ -245,26 +181,52 @@ def _one_stage(plan: Plan, architecture: Architecture, label: str | None) -> Arc
     raise PlanError(plan.source, architecture.key, f"has no stage {label!r} (--stage)")
 
 
+def _selected(plan: Plan, request: EstimateRequest) -> Plan:
+    """The architectures ``--architecture`` names (all when none), each with only the stage
+    ``--actual`` compares."""
+    chosen = plan.architectures
+    if request.architectures:
+        known = {a.name for a in chosen}
+        for name in request.architectures:
+            if name not in known:
+                names = ", ".join(a.name for a in chosen)
+                raise PlanError(plan.source, "", f"no architecture {name!r} (the plan has {names})")
+        chosen = tuple(a for a in chosen if a.name in request.architectures)
+    if request.actual is not None:
+        chosen = tuple(_one_stage(plan, a, request.stage) for a in chosen)
+    return replace(plan, architectures=chosen)
+
+
 def run_estimate(
     request: EstimateRequest, progress: Progress | None = None, cache: FactsCache | None = None
 ) -> EstimateReport:
     """Read the plan, measure the base, estimate every architecture, check the gates; with
     ``actual``, measure base..actual too and the error of every estimated figure."""
     gates = gates_of(request.diff)  # a bad gate or plan fails before any work
-    plan = read_plan_file(request.plan)
-    if request.actual is not None:
-        chosen = tuple(_one_stage(plan, a, request.stage) for a in plan.architectures)
-        plan = replace(plan, architectures=chosen)
+    plan = _selected(read_plan_file(request.plan), request)
     progress = progress or NoProgress()
-    progress.phase(f"reading {request.diff.base}")
     repo = git.open_repository(request.diff.root)
     root = git.toplevel(repo)
-    base = open_snapshot(root, request.diff.base)
-    state, warnings = measure_base(request.diff, root, base, progress, cache)
-    context = _Context(request.diff, root, repo, base, state, warnings, progress, cache)
+    bases: dict[str, MeasuredBase] = {}
     estimates, failures = [], []
     for architecture in plan.architectures:
-        estimate, failed = _estimate(plan, architecture, context, gates)
+        revision = request.diff.base
+        if architecture.base is not None and request.actual is None:
+            revision = architecture.base
+        if revision not in bases:
+            progress.phase(f"reading {revision}")
+            diff = replace(request.diff, base=revision)
+            try:
+                snapshot = open_snapshot(root, revision)
+            except SourceError as error:
+                if revision == request.diff.base:
+                    raise
+                raise PlanError(plan.source, f"{architecture.key}.base", str(error)) from None
+            state, warnings = measure_base(diff, root, snapshot, progress, cache)
+            bases[revision] = MeasuredBase(
+                diff, root, repo, snapshot, state, warnings, progress, cache
+            )
+        estimate, failed = _estimate(plan, architecture, bases[revision], gates)
         estimates.append(estimate)
         failures += failed
     report = EstimateReport(

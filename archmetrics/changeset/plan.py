@@ -106,6 +106,7 @@ class Architecture:
     key: str
     stages: tuple[PlannedStage, ...]
     description: str = ""
+    base: str | None = None  # the revision its stages start from (default: --base)
 
 
 @dataclass(frozen=True, slots=True)

@@ -127,7 +127,8 @@ def _architecture(reader: _Reader, name: str, value: object) -> Architecture:
     key = f"architecture.{name}"
     if not _NAME.fullmatch(name):
         raise reader.fail(key, "an architecture's name is 1-64 letters, digits, '.', '_', '-'")
-    table = reader.table(value, key, {"description", "element", "sketch", "stage"})
+    table = reader.table(value, key, {"base", "description", "element", "sketch", "stage"})
+    base = reader.text(table["base"], f"{key}.base") if "base" in table else None
     description = (
         reader.text(table["description"], f"{key}.description") if "description" in table else ""
     )
@@ -147,7 +148,7 @@ def _architecture(reader: _Reader, name: str, value: object) -> Architecture:
             labels.add(stage.label)
     else:
         stages = (_stage_body(reader, table, key, "estimate"),)
-    return Architecture(name, key, stages, description)
+    return Architecture(name, key, stages, description, base)
 
 
 def _stage(reader: _Reader, value: object, key: str) -> PlannedStage:

@@ -23,6 +23,7 @@ def estimate_command(args: argparse.Namespace) -> int:
         diff_request(args, args.repo, args.base, ""),
         args.head if args.actual else None,
         args.stage,
+        tuple(args.architecture),
     )
     with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
         report = run_estimate(request, p, cache)

@@ -203,6 +203,13 @@ def build_parser() -> argparse.ArgumentParser:
     estimate.add_argument(
         "--stage", help="with --actual: the stage to compare (default: the plan's only stage)"
     )
+    estimate.add_argument(
+        "--architecture",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="estimate only this architecture of the plan (repeatable; default: all)",
+    )
     add_locations(estimate)
     add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])

@@ -473,3 +473,34 @@ def test_a_staged_plan_gives_the_series_each_stage_on_the_one_before(
     )
     _, err = run(sketched, capsys, str(mixed), "--base", "base", status=2)
     assert "architecture.m: mixes planned and sketched stages" in err
+
+
+def test_an_architecture_may_start_from_its_own_base_and_be_chosen_alone(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = write_plan(
+        tmp_path,
+        """\
+        [architecture.later]
+        base = "sketch"
+        [[architecture.later.element]]
+        name = "app/main.py"
+        statements_added = 1
+        [[architecture.now.element]]
+        name = "app/main.py"
+        statements_added = 1
+        """,
+    )
+    document = estimate(sketched, capsys, plan)
+    later = document["architectures"]["later"]["stages"][0]
+    now = document["architectures"]["now"]["stages"][0]
+    assert (later["base"], now["base"]) == ("sketch", "base")
+    assert later["locations"]["base"]["loc_pre"] == 22  # main.py 13 + server.py 9 at sketch
+    assert now["locations"]["base"]["loc_pre"] == 14
+    alone = estimate(sketched, capsys, plan, "--architecture", "now")
+    assert list(alone["architectures"]) == ["now"]
+    _, err = run(sketched, capsys, str(plan), "--architecture", "never", status=2)
+    assert f"{plan}: no architecture 'never' (the plan has later, now)" in err
+    bad = write_plan(tmp_path, '[architecture.x]\nbase = "nowhere"\nelement = []\n', "bad.toml")
+    _, err = run(sketched, capsys, str(bad), "--base", "base", status=2)
+    assert f"{bad}: architecture.x.base: unknown revision 'nowhere'" in err
