@@ -231,7 +231,7 @@ def run_estimate(
         failures += failed
     report = EstimateReport(
         plan.source,
-        request.diff.base,
+        ", ".join(bases),  # the revisions the architectures start from
         tuple(estimates),
         tuple(g.text for g in gates),
         tuple(failures),

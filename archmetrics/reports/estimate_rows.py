@@ -63,13 +63,23 @@ def ranking_rows(report: EstimateReport) -> list[list[str]]:
 
 
 def notes(report: EstimateReport, label: str) -> list[str]:
-    """Every note of a stage once, prefixed with the architecture and locations it is of."""
-    where: dict[str, list[str]] = {}
-    for name, _, stage in stages_named(report, label):
+    """Every note of a stage once, prefixed with where it applies: ``all``, an architecture
+    (all its locations) or an architecture's locations."""
+    where: dict[str, dict[str, list[str]]] = {}
+    named = stages_named(report, label)
+    for name, _, stage in named:
         for column, summary in stage.report.summaries().items():
             for note in summary.notes:
-                where.setdefault(note, []).append(f"{name} {column}")
-    return [f"[{', '.join(cols)}] {note}" for note, cols in where.items()]
+                where.setdefault(note, {}).setdefault(name, []).append(column)
+    lines = []
+    for note, places in where.items():
+        whole = [n for n, cols in places.items() if len(cols) == len(LOCATION_COLUMNS)]
+        if len(whole) == len(named) > 1:
+            lines.append(f"[all] {note}")
+            continue
+        parts = [n if n in whole else f"{n} {', '.join(cols)}" for n, cols in places.items()]
+        lines.append(f"[{'; '.join(parts)}] {note}")
+    return lines
 
 
 # --actual: the figures a table or Markdown shows per location (JSON and CSV have them all)
@@ -113,10 +123,14 @@ def _cells(figure: FigureError) -> list[str]:
 
 
 def accuracy_rows(report: EstimateReport) -> list[list[str]]:
-    """Per architecture and location (total last), the main figures against the measured."""
+    """Per architecture and location (total last), the main figures against the measured;
+    a location with nothing estimated or measured is left out."""
     rows = []
     for name, accuracy in report.accuracy:
         for place in accuracy.locations:
+            figures = [place.figure(field) for field, _ in ACCURACY_FIGURES]
+            if all(not f.estimated and not f.actual for f in figures):
+                continue  # a location empty on both sides (JSON and CSV still have it)
             for field, label in ACCURACY_FIGURES:
                 rows.append([name, place.name, label, *_cells(place.figure(field))])
     return rows
