@@ -504,3 +504,27 @@ def test_an_architecture_may_start_from_its_own_base_and_be_chosen_alone(
     bad = write_plan(tmp_path, '[architecture.x]\nbase = "nowhere"\nelement = []\n', "bad.toml")
     _, err = run(sketched, capsys, str(bad), "--base", "base", status=2)
     assert f"{bad}: architecture.x.base: unknown revision 'nowhere'" in err
+
+
+def test_a_sketch_cannot_reach_outside_its_tree(
+    sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    outside = tmp_path / "secret.py"
+    outside.write_text("def leaked():\n    return 1\n", encoding="utf-8")
+    (tmp_path / "up.patch").write_text(
+        "diff --git a/../../x.py b/../../x.py\nnew file mode 100644\n--- /dev/null\n"
+        "+++ b/../../x.py\n@@ -0,0 +1 @@\n+x = 1\n",
+        encoding="utf-8",
+    )
+    plan = write_plan(tmp_path, '[architecture.a]\nsketch = { patch = "up.patch" }\n')
+    _, err = run(sketched, capsys, str(plan), "--base", "base", status=2)
+    assert f"{plan}: architecture.a.sketch.patch: the patch does not apply" in err
+    assert not (tmp_path.parent / "x.py").exists()
+    stubs = tmp_path / "stubs" / "app"
+    stubs.mkdir(parents=True)
+    (stubs / "linked.py").symlink_to(outside)  # a stub that is a link is not followed
+    (stubs / "real.py").write_text("y = 2\n", encoding="utf-8")
+    plan = write_plan(tmp_path, '[architecture.a]\nsketch = { stubs = "stubs" }\n', "s.toml")
+    document = estimate(sketched, capsys, plan)
+    files = {e["element"] for e in document["architectures"]["a"]["stages"][0]["elements"]}
+    assert "app/real.py" in files and "app/linked.py" not in files
