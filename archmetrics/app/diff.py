@@ -279,7 +279,8 @@ def pair_files(
     return pairs
 
 
-def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+def parse_warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+    """Every distinct parse warning of the files of each side, in order."""
     seen: dict[str, ParseWarning] = {}
     for side in sides:
         for facts in side:
@@ -355,7 +356,7 @@ def measure_snapshots(
         diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
     progress.stop()
-    return change, _warnings(pre, post)
+    return change, parse_warnings(pre, post)
 
 
 def gates_of(request: DiffRequest) -> tuple[Gate, ...]:

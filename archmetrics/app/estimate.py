@@ -11,7 +11,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from archmetrics.app.coupling import coupling_options, rule_set
 from archmetrics.app.diff import (
@@ -20,6 +19,7 @@ from archmetrics.app.diff import (
     location_rules,
     measure_change,
     parse_side,
+    parse_warnings,
     site_memo,
 )
 from archmetrics.app.progress import NoProgress, Progress
@@ -31,7 +31,7 @@ from archmetrics.changeset.gates import Gate, check_gates
 from archmetrics.changeset.plan import Architecture, Plan, PlanError
 from archmetrics.changeset.plan_read import MAX_PLAN_BYTES, read_plan
 from archmetrics.coupling import group_elements, measure_coupling
-from archmetrics.facts import FileFacts, ParseWarning
+from archmetrics.facts import ParseWarning
 from archmetrics.reports.model import (
     ArchitectureEstimate,
     DiffReport,
@@ -42,9 +42,6 @@ from archmetrics.reports.model import (
 )
 from archmetrics.sources import Snapshot, SourceError, git, open_snapshot
 from archmetrics.sources.cache import FactsCache
-
-if TYPE_CHECKING:
-    pass
 
 __all__ = ["EstimateRequest", "measure_base", "read_plan_file", "run_estimate"]
 
@@ -105,15 +102,7 @@ def measure_base(
         values,
     )
     progress.stop()
-    return base_state(change, coupling), _parse_warnings(files)
-
-
-def _parse_warnings(files: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
-    seen: dict[str, ParseWarning] = {}
-    for facts in files:
-        for warning in facts.warnings:
-            seen.setdefault(str(warning), warning)
-    return tuple(seen.values())
+    return base_state(change, coupling), parse_warnings(files)
 
 
 def _planned(plan: Plan, architecture: Architecture, context: MeasuredBase) -> list[ChangeReport]:
@@ -123,7 +112,7 @@ def _planned(plan: Plan, architecture: Architecture, context: MeasuredBase) -> l
     return apply_stages(
         plan.source,
         context.state,
-        [s for s in architecture.stages],
+        architecture.stages,
         location_rules(request),
         roles,
         dynamic_pre_zero=request.dynamic_pre_zero,
@@ -154,9 +143,11 @@ def _estimate(
         found = sketched(plan, architecture, context)
     stages, failures = [], []
     texts = tuple(g.text for g in gates)
+    before = context.request.base  # each stage is estimated on the one before it
     for stage, (change, warnings) in zip(architecture.stages, found, strict=True):
         head = f"{architecture.name}/{stage.label} (estimate)"
-        report = DiffReport(context.request.base, head, change, warnings, texts)
+        report = DiffReport(before, head, change, warnings, texts)
+        before = head
         failed = check_gates(gates, report.summaries())
         stages.append(Stage(stage.label, replace(report, failures=failed)))
         failures += [EstimateFailure(architecture.name, stage.label, f) for f in failed]
