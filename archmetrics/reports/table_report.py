@@ -187,9 +187,12 @@ def render_estimate(report: EstimateReport, color: bool = False) -> str:
         header = estimate_rows.summary_header(report, label)
         title = f"archmetrics estimate ({estimate_rows.LABEL}): {report.plan} on {report.base}"
         stage = "" if label == "estimate" else f", stage {label}"
-        parts.append(
-            rows_table(title + stage, tuple(header), estimate_rows.summary_rows(report, label), 2)
-        )
+        # on a narrow terminal the totals stay longest: framework, base, then new go first
+        least_useful = [
+            h for where in (" framework", " base", " new") for h in header if h.endswith(where)
+        ]
+        rows = estimate_rows.summary_rows(report, label)
+        parts.append(rows_table(title + stage, tuple(header), rows, 2, None, least_useful))
         element_header = ("architecture", *diff_rows.ELEMENT_HEADER)
         rows = estimate_rows.element_rows(report, label)
         if rows:
