@@ -74,10 +74,13 @@ class Planner:
                     )
             return
         if found is None:
-            raise self.fail(
-                f"{planned.key}.name",
-                f"unknown element {planned.name!r}: not in the base (`new = true` plans a new one)",
+            owner = self.file_owner.get(planned.name)
+            hint = (
+                f"it is a file of element {owner!r}"
+                if owner
+                else "not in the base (`new = true` plans a new one)"
             )
+            raise self.fail(f"{planned.key}.name", f"unknown element {planned.name!r}: {hint}")
         if planned.location is not None and planned.location is not found.location:
             raise self.fail(
                 f"{planned.key}.location",

@@ -144,6 +144,10 @@ def test_a_bare_rule_id_is_ambiguous_when_packs_give_it_different_roles() -> Non
             "e.statements_modified: a new element has nothing to remove or modify",
         ),
         (
+            PlannedElement("lib/net.c", "e", added=1),
+            "e.name: unknown element 'lib/net.c': it is a file of element 'lib/net'",
+        ),
+        (
             PlannedElement("app/client.py", "e", static_dependencies=("app/client.py",)),
             "e.static_dependencies[0]: element 'app/client.py' cannot depend on itself",
         ),
