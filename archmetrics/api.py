@@ -1,4 +1,4 @@
-"""archmetrics for notebooks: scans, diffs, series and comparisons as pandas DataFrames.
+"""archmetrics for notebooks: scans, diffs, series, comparisons and estimates as DataFrames.
 
 Each function measures as the command of the same name does (the repository's configuration,
 the facts cache, the parser processes) and returns one row per function, file, element,
@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 from archmetrics.app.collect import open_cache
 from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.estimate import EstimateRequest, run_estimate
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, run_compare, run_series
 from archmetrics.app.settings import settings_for
@@ -27,7 +28,9 @@ from archmetrics.config import Settings
 from archmetrics.reports.frames import (
     SCAN_GROUPINGS,
     Table,
+    accuracy_table,
     diff_table,
+    estimate_table,
     scan_table,
     trend_table,
 )
@@ -39,7 +42,7 @@ from archmetrics.sources.checkout import open_checkout
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["compare", "diff", "scan", "series"]
+__all__ = ["compare", "diff", "estimate", "scan", "series"]
 
 
 def scan(
@@ -130,6 +133,29 @@ def compare(
     with _cache(named[0][1].diff.settings, cache) as facts:
         report = run_compare(named, cache=facts)
     return _frame(trend_table(report))
+
+
+def estimate(
+    plan: str | Path,
+    repo: str | Path = ".",
+    base: str = "HEAD",
+    *,
+    actual: str | None = None,
+    stage: str | None = None,
+    new: Sequence[str] = (),
+    framework: Sequence[str] = (),
+    exclude: Sequence[str] = (),
+    cache: bool = True,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """Each architecture of ``plan`` estimated against ``base``, as ``archmetrics estimate``:
+    the diff's rows per architecture and stage. With ``actual`` (a revision), each figure's
+    error against the measured ``base..actual`` instead, as ``estimate --actual``."""
+    diff = _diff_request(Path(repo), new, framework, exclude, jobs, base)
+    request = EstimateRequest(Path(plan), diff, actual, stage)
+    with _cache(diff.settings, cache) as facts:
+        report = run_estimate(request, cache=facts)
+    return _frame(estimate_table(report) if actual is None else accuracy_table(report))
 
 
 def _frame(table: Table) -> pd.DataFrame:

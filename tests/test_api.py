@@ -106,3 +106,23 @@ def test_the_api_uses_the_facts_cache_the_configuration_names(
     first = api.scan(stages.root, by="function")
     assert (tmp_path / "api.sqlite3").exists()
     pd.testing.assert_frame_equal(api.scan(stages.root, by="function"), first)
+
+
+def test_an_estimate_frame_has_the_rows_and_columns_of_the_csv(
+    stages: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = tmp_path / "plan.toml"
+    plan.write_text(
+        '[[architecture.a.element]]\nname = "core/m.py"\nstatements_added = 3\n'
+        "functions_added = 1\ndecisions_added = 1\n"
+        '[architecture.b]\nsketch = { revision = "first" }\n',
+        encoding="utf-8",
+    )
+    frame = api.estimate(plan, stages.root, "baseline", cache=False)
+    argv = ["estimate", str(plan), "-C", str(stages.root), "--base", "baseline"]
+    _same(frame, _csv(capsys, *argv))
+    assert set(frame["architecture"]) == {"a", "b"}
+    errors = api.estimate(plan, stages.root, "baseline", actual="first", cache=False)
+    _same(errors, _csv(capsys, *argv, "--actual", "--head", "first"))
+    total = errors.query("architecture == 'b' and name == 'total' and figure == 'cost'")
+    assert total["error"].tolist() == [0.0]  # the sketch is the measured change

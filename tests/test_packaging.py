@@ -52,6 +52,8 @@ def test_wheel_contents(wheel: Path) -> None:
         "archmetrics/schemas/diff-1.schema.json",
         "archmetrics/schemas/series-1.schema.json",
         "archmetrics/schemas/compare-1.schema.json",
+        "archmetrics/schemas/plan-1.schema.json",
+        "archmetrics/schemas/estimate-1.schema.json",
     ):
         assert required in names, required
     assert not [n for n in names if "__pycache__" in n or n.endswith((".pyc", ".o", ".so"))]

@@ -291,7 +291,8 @@ def change_key(
     return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
-def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+def parse_warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
+    """Every distinct parse warning of the files of each side, in order."""
     seen: dict[str, ParseWarning] = {}
     for side in sides:
         for facts in side:
@@ -300,7 +301,7 @@ def _warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
     return tuple(seen.values())
 
 
-def _parse_side(
+def parse_side(
     snapshot: Snapshot,
     options: DiffOptions,
     progress: Progress | None,
@@ -329,22 +330,37 @@ def measure_change(
     progress.phase(f"reading {request.base} and {request.head}")
     checkout = checkout or open_checkout(request.root)
     options = options or diff_options(request, checkout.root)
-    base, head = checkout.snapshot(request.base), checkout.snapshot(request.head)
+    snapshots = (checkout.snapshot(request.base), checkout.snapshot(request.head))
+    renames = checkout.renames(request.base, request.head)
+    return measure_snapshots(options, snapshots, renames, progress, cache)
+
+
+def measure_snapshots(
+    options: DiffOptions,
+    snapshots: tuple[Snapshot, Snapshot],
+    renames: Mapping[str, str],
+    progress: Progress | None = None,
+    cache: FactsCache | None = None,
+) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
+    """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
+    path), under ``options``."""
+    progress = progress or NoProgress()
+    base, head = snapshots
     rules = options.rules
     pre_blobs: dict[str, str] = {}
     post_blobs: dict[str, str] = {}
-    pre = _parse_side(base, options, progress, cache, pre_blobs)
-    progress.phase(f"reading {request.head}")
-    post = _parse_side(head, options, progress, cache, post_blobs)
+    pre = parse_side(base, options, progress, cache, pre_blobs)
+    progress.phase(f"reading {head.label}")
+    post = parse_side(head, options, progress, cache, post_blobs)
     coupling, packs = options.coupling, options.packs
-    progress.phase(f"coupling {request.base}")
+    progress.phase(f"coupling {base.label}")
     pre_coupling = coupling_values(pre, rules, coupling, packs, cache, pre_blobs)
-    progress.phase(f"coupling {request.head}")
+    progress.phase(f"coupling {head.label}")
     post_coupling = coupling_values(post, rules, coupling, packs, cache, post_blobs)
     progress.phase("comparing the changed files")
     paths = {f.path for f in (*pre, *post)}
     change = compute_change(
-        pair_files(pre, post, checkout.renames(request.base, request.head)),
+        pair_files(pre, post, renames),
         group_elements(paths, coupling.per_file),
         rules,
         pre_coupling,
@@ -353,7 +369,7 @@ def measure_change(
         diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
     progress.stop()
-    return change, _warnings(pre, post)
+    return change, parse_warnings(pre, post)
 
 
 def run_diff(

@@ -5,7 +5,7 @@ Thesis chapter 6 (Hestand 2011, pp. 98-107). Entry point: :func:`compute_change`
 
 from __future__ import annotations
 
-from archmetrics.changeset.compute import compute_change, coupling_by_element
+from archmetrics.changeset.compute import compute_change, coupling_by_element, report_of
 from archmetrics.changeset.cost import Sums, location_summary, total_summary
 from archmetrics.changeset.locations import Location, LocationRule, LocationRules
 from archmetrics.changeset.model import (
@@ -49,5 +49,6 @@ __all__ = [
     "diff_files",
     "diff_statements",
     "location_summary",
+    "report_of",
     "total_summary",
 ]

@@ -41,6 +41,7 @@ from archmetrics.changeset.model import (
     ChangeReport,
     Coupling,
     ElementChange,
+    ExcludedFile,
     FilePair,
     Metrics,
 )
@@ -68,7 +69,7 @@ def _sums(elements: Iterable[ElementChange]) -> Sums:
     return Sums(pre, post, added, removed, modified)
 
 
-def _side_notes(sides: tuple[Side, Side]) -> list[str]:
+def side_notes(sides: tuple[Side, Side]) -> list[str]:
     notes: list[str] = []
     for side in sides:
         if side.values is None:
@@ -99,22 +100,39 @@ def compute_change(
     groups = assign(kept, element_index(elements))
     sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
     changes: list[ElementChange] = []
-    notes: dict[Location, list[str]] = {loc: [] for loc in Location}
+    notes: list[tuple[Location, str]] = []
     for name in sorted(groups):
         element_notes: list[str] = []
         change = element_change(name, groups[name], rules, sides, element_notes, diff)
         changes.append(change)
-        notes[change.location] += element_notes
-    common = _side_notes(sides)
+        notes += [(change.location, n) for n in element_notes]
+    return report_of(changes, excluded, side_notes(sides), notes)
+
+
+def report_of(
+    changes: Iterable[ElementChange],
+    excluded: Iterable[ExcludedFile] = (),
+    common: Iterable[str] = (),
+    notes: Iterable[tuple[Location, str]] = (),
+) -> ChangeReport:
+    """S(L) per location and S_tot from element change sets however they were found: by
+    diffing files (:func:`compute_change`) or from an integration plan (changeset/plan.py).
+
+    ``common`` notes apply to every location, ``notes`` to one location each."""
+    changes = tuple(changes)
+    common = tuple(common)
+    by_location: dict[Location, list[str]] = {loc: [] for loc in Location}
+    for location, note in notes:
+        by_location[location].append(note)
     summaries = tuple(
         (
             loc,
             location_summary(
-                _sums(c for c in changes if c.location is loc), (*common, *notes[loc])
+                _sums(c for c in changes if c.location is loc), (*common, *by_location[loc])
             ),
         )
         for loc in Location
     )
-    all_notes = [*common, *(n for loc in Location for n in notes[loc])]
+    all_notes = [*common, *(n for loc in Location for n in by_location[loc])]
     total = total_summary((s for _, s in summaries), all_notes)
-    return ChangeReport(summaries, total, tuple(changes), tuple(excluded))
+    return ChangeReport(summaries, total, changes, tuple(excluded))

@@ -17,7 +17,8 @@ from contextlib import contextmanager
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.locations import BadPattern
-from archmetrics.cli import measure, study
+from archmetrics.changeset.plan import PlanError
+from archmetrics.cli import estimate, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
@@ -35,6 +36,7 @@ COMMANDS = {
     "diff": measure.diff_command,
     "series": measure.series_command,
     "compare": measure.compare_command,
+    "estimate": estimate.estimate_command,
     "replicate": study.replicate_command,
     "rules": measure.rules_command,
     "graph": measure.graph_command,
@@ -52,6 +54,7 @@ CANNOT_MEASURE = (
     SeriesError,
     ManifestError,
     CacheError,
+    PlanError,
 )
 
 

@@ -18,6 +18,7 @@ from archmetrics.changeset.locations import BadPattern
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import Settings
 from archmetrics.reports.formats import OutputFormat
+from archmetrics.reports.model import EstimateFailure
 from archmetrics.reports.printable import one_line, shown_lines
 from archmetrics.reports.table_report import SHOWN_FAILURES
 from archmetrics.sources.cache import FactsCache, choose_path
@@ -179,7 +180,7 @@ def _detail(args: argparse.Namespace, text: str) -> None:
 
 
 def gate_status(
-    failures: Sequence[GateFailure | ThresholdFailure], args: argparse.Namespace
+    failures: Sequence[GateFailure | ThresholdFailure | EstimateFailure], args: argparse.Namespace
 ) -> int:
     """Exit 1 if a gate failed, else 0. Each failure goes to stderr unless the report itself
     showed it on stdout (a table or Markdown, every report lists its failed gates): a

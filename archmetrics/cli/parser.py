@@ -183,6 +183,36 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    estimate = commands.add_parser(
+        "estimate",
+        help="price an integration before doing it: each architecture of a plan (TOML) or"
+        " sketch estimated against a measured base, ranked (docs/estimate.md)",
+    )
+    estimate.add_argument("plan", metavar="PLAN", help="the plan file (TOML, docs/estimate.md)")
+    estimate.add_argument(
+        "--base", default="HEAD", help="the revision the plan applies to (default HEAD)"
+    )
+    estimate.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    estimate.add_argument(
+        "--actual",
+        action="store_true",
+        help="after the integration: compare the estimate with the measured --base..--head,"
+        " per location and per element, and report each figure's error",
+    )
+    estimate.add_argument("--head", help="with --actual: the revision the integration is in")
+    estimate.add_argument(
+        "--stage", help="with --actual: the stage to compare (default: the plan's only stage)"
+    )
+    estimate.add_argument(
+        "--architecture",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="estimate only this architecture of the plan (repeatable; default: all)",
+    )
+    add_locations(estimate)
+    add_chart(estimate)
+    add_output(estimate, [f.value for f in OutputFormat])
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )

@@ -16,7 +16,13 @@ from collections.abc import Iterable
 from typing import Any
 
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
+from archmetrics.reports.model import (
+    CompareReport,
+    DiffReport,
+    EstimateReport,
+    ScanReport,
+    SeriesReport,
+)
 
 SEVERITY = "major"  # a gate the team set failed: the pipeline fails too
 
@@ -81,3 +87,8 @@ def render_compare(report: CompareReport) -> str:
             name = f"{approach} {stage.label}".strip()
             issues += _gates(stage.report.failures, name)
     return _dump(issues)
+
+
+def render_estimate(report: EstimateReport) -> str:
+    """Every failed gate of every architecture's stage (estimated figures)."""
+    return render_compare(report.compare())

@@ -6,8 +6,21 @@ from __future__ import annotations
 import csv
 import io
 
-from archmetrics.reports.frames import Table, diff_table, scan_table, trend_table
-from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
+from archmetrics.reports.frames import (
+    Table,
+    accuracy_table,
+    diff_table,
+    estimate_table,
+    scan_table,
+    trend_table,
+)
+from archmetrics.reports.model import (
+    CompareReport,
+    DiffReport,
+    EstimateReport,
+    ScanReport,
+    SeriesReport,
+)
 
 
 def _csv(table: Table) -> str:
@@ -36,3 +49,9 @@ def render_series(report: SeriesReport) -> str:
 
 def render_compare(report: CompareReport) -> str:
     return _csv(trend_table(report))
+
+
+def render_estimate(report: EstimateReport) -> str:
+    """The diff's rows (a row per location, then per element) for every architecture and
+    stage, named in the first two columns; with --actual, each figure's error instead."""
+    return _csv(estimate_table(report) if report.actual is None else accuracy_table(report))

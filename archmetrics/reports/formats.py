@@ -12,7 +12,13 @@ from archmetrics.reports import (
     markdown_report,
     table_report,
 )
-from archmetrics.reports.model import CompareReport, DiffReport, ScanReport, SeriesReport
+from archmetrics.reports.model import (
+    CompareReport,
+    DiffReport,
+    EstimateReport,
+    ScanReport,
+    SeriesReport,
+)
 from archmetrics.reports.printable import printable
 
 
@@ -99,3 +105,17 @@ def render_series(report: SeriesReport, fmt: OutputFormat, max_rows: int | None 
 
 def render_compare(report: CompareReport, fmt: OutputFormat) -> str:
     return _safe(fmt, _COMPARE[fmt](report))
+
+
+_ESTIMATE: dict[OutputFormat, Callable[[EstimateReport], str]] = {
+    OutputFormat.TABLE: table_report.render_estimate,
+    OutputFormat.JSON: json_report.render_estimate,
+    OutputFormat.MARKDOWN: markdown_report.render_estimate,
+    OutputFormat.CSV: csv_report.render_estimate,
+    OutputFormat.CODECLIMATE: codeclimate_report.render_estimate,
+}
+assert set(_ESTIMATE) == set(OutputFormat), "every output format needs an estimate renderer"
+
+
+def render_estimate(report: EstimateReport, fmt: OutputFormat) -> str:
+    return _safe(fmt, _ESTIMATE[fmt](report))

@@ -16,6 +16,7 @@ from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -110,3 +111,32 @@ def _trend_rows(approach: str, series: SeriesReport) -> list[tuple[Cell, ...]]:
             values = tuple(getattr(summary, f) for f, _ in TREND_FIELDS)
             rows.append((approach, stage.label, location, *values))
     return rows
+
+
+def estimate_table(report: EstimateReport) -> Table:
+    """:func:`diff_table` of every architecture's stages, with ``architecture`` and ``stage``
+    columns in front (an estimate: planned or sketched figures)."""
+    columns: tuple[str, ...] = ()
+    rows: list[tuple[Cell, ...]] = []
+    for architecture in report.architectures:
+        for stage in architecture.series.stages:
+            table = diff_table(stage.report)
+            columns = ("architecture", "stage", *table.columns)
+            rows += [(architecture.name, stage.label, *row) for row in table.rows]
+    return Table(columns, rows)
+
+
+def accuracy_table(report: EstimateReport) -> Table:
+    """--actual: a row per architecture, location or element, and figure: estimated,
+    measured, error (estimated − measured) and relative error (error / |measured|)."""
+    rows: list[tuple[Cell, ...]] = []
+    for name, accuracy in report.accuracy:
+        for scope, places in (("location", accuracy.locations), ("element", accuracy.elements)):
+            for place in places:
+                for f in place.figures:
+                    rows.append(
+                        (name, scope, place.name, place.location, f.figure, f.estimated,
+                         f.actual, f.error, f.relative)
+                    )  # fmt: skip
+    columns = ("architecture", "row", "name", "location", "figure", "estimated", "actual")
+    return Table((*columns, "error", "relative"), rows)

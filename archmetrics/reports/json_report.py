@@ -6,16 +6,19 @@ import json
 import re
 from typing import Any
 
+from archmetrics.changeset.accuracy import Accuracy
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
 from archmetrics.reports.model import (
     COMPARE_SCHEMA,
     DIFF_SCHEMA,
+    ESTIMATE_SCHEMA,
     SCAN_SCHEMA,
     SERIES_SCHEMA,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -152,3 +155,73 @@ def compare_dict(report: CompareReport) -> dict[str, Any]:
 
 def render_compare(report: CompareReport) -> str:
     return dumps(compare_dict(report))
+
+
+def estimate_dict(report: EstimateReport) -> dict[str, Any]:
+    """Each architecture's stages as the diff JSON has them, and the ranking; ``estimate``
+    is always true: these are planned or sketched figures, not the integration measured."""
+    architectures = {}
+    for architecture in report.architectures:
+        document = series_dict(architecture.series)
+        architectures[architecture.name] = {
+            "kind": architecture.kind,
+            "description": architecture.description,
+            "stages": document["stages"],
+        }
+    failed = {(f.architecture, f.stage, f.failure.gate.text) for f in report.failures}
+    return {
+        "schema": ESTIMATE_SCHEMA,
+        "estimate": True,
+        "plan": report.plan,
+        "base": report.base,
+        "architectures": architectures,
+        "ranking": [
+            {
+                "stage": r.stage,
+                "rank": r.rank,
+                "architecture": r.architecture,
+                "cost": r.cost,
+                "scaled_changes": r.scaled_changes,
+                "scaled_delta_vg": r.scaled_delta_vg,
+            }
+            for r in report.ranking()
+        ],
+        "failures": [{"architecture": a, "stage": s, "gate": g} for a, s, g in sorted(failed)],
+    }
+
+
+def _figures(place: Accuracy) -> dict[str, Any]:
+    return {
+        f.figure: {
+            "estimated": f.estimated,
+            "actual": f.actual,
+            "error": f.error,
+            "relative": f.relative,
+        }
+        for f in place.figures
+    }
+
+
+def accuracy_dict(report: EstimateReport) -> dict[str, Any]:
+    """--actual: the measured change, and per architecture every figure's error."""
+    assert report.actual is not None
+    actual = diff_dict(report.actual)
+    del actual["schema"]
+    accuracy = {
+        name: {
+            "locations": {place.name: _figures(place) for place in found.locations},
+            "elements": [
+                {"element": e.name, "location": e.location, "figures": _figures(e)}
+                for e in found.elements
+            ],
+        }
+        for name, found in report.accuracy
+    }
+    return {"actual": actual, "accuracy": accuracy}
+
+
+def render_estimate(report: EstimateReport) -> str:
+    document = estimate_dict(report)
+    if report.actual is not None:
+        document.update(accuracy_dict(report))
+    return dumps(document)

@@ -5,11 +5,12 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from archmetrics.changeset.model import ElementChange
-from archmetrics.reports import coupling_rows, diff_rows
+from archmetrics.reports import coupling_rows, diff_rows, estimate_rows
 from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -159,3 +160,41 @@ def render_compare(report: CompareReport) -> str:
     return f"## Compared: {names}\n\n" + table(
         list(diff_rows.TREND_HEADER), diff_rows.compare_rows(report), "lll" + "r" * 10
     )
+
+
+def render_estimate(report: EstimateReport) -> str:
+    """Per stage, the per-location figures with one column group per architecture and the
+    changed elements; then the ranking. The heading says it is an estimate."""
+    parts = [
+        f"## archmetrics estimate: `{report.plan}` on `{report.base}`\n",
+        f"*{estimate_rows.LABEL}*\n",
+    ]
+    for label in report.stage_labels():
+        if label != "estimate":
+            parts.append(f"### Stage {label}\n")
+        header = estimate_rows.summary_header(report, label)
+        parts.append(
+            table(header, estimate_rows.summary_rows(report, label), "ll" + "r" * (len(header) - 2))
+        )
+        rows = estimate_rows.element_rows(report, label)
+        if rows:
+            element_header = ["architecture", *diff_rows.ELEMENT_HEADER]
+            parts.append(table(element_header, rows, "llll" + "r" * (len(element_header) - 4)))
+    parts.append("### Ranking: cheapest total E first\n")
+    parts.append(table(estimate_rows.RANKING_HEADER, estimate_rows.ranking_rows(report), "lrlrrr"))
+    if report.actual is not None:
+        parts.append(
+            f"### Accuracy: the estimate against the measured "
+            f"`{report.actual.base}` → `{report.actual.head}`\n"
+        )
+        rows = estimate_rows.accuracy_rows(report)
+        parts.append(table(estimate_rows.ACCURACY_HEADER, rows, "lllrrrr"))
+        elements = estimate_rows.element_accuracy_rows(report)
+        if elements:
+            parts.append("#### Elements: the figures the estimate got wrong\n")
+            parts.append(table(estimate_rows.ELEMENT_ACCURACY_HEADER, elements, "llllrrrr"))
+    bullets = [f"- {f}" for f in report.failures]
+    bullets += [
+        f"- note {n}" for label in report.stage_labels() for n in estimate_rows.notes(report, label)
+    ]
+    return "\n".join(parts + (["\n".join(bullets) + "\n"] if bullets else []))

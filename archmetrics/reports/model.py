@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from archmetrics.changeset.accuracy import ChangeAccuracy
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
@@ -114,3 +115,86 @@ class CompareReport:
     @property
     def failures(self) -> tuple[GateFailure, ...]:
         return tuple(f for _, s in self.series for f in s.failures)
+
+
+ESTIMATE_SCHEMA = "archmetrics.estimate/1"
+
+
+@dataclass(frozen=True, slots=True)
+class ArchitectureEstimate:
+    """One candidate architecture's estimate: a series of stages measured against the base.
+
+    ``kind``: ``plan`` (planned counts applied to the measured base) or ``sketch:revision``,
+    ``sketch:patch``, ``sketch:stubs`` (code measured as ``diff`` would). Either way an
+    estimate, never the integration itself."""
+
+    name: str
+    kind: str
+    series: SeriesReport
+    description: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class EstimateFailure:
+    """A gate that fails on one architecture's stage."""
+
+    architecture: str
+    stage: str
+    failure: GateFailure
+
+    def __str__(self) -> str:
+        return f"{self.architecture} ({self.stage}): {self.failure}"
+
+
+@dataclass(frozen=True, slots=True)
+class Ranked:
+    """One architecture's place for one stage: cheapest total E first (docs/estimate.md)."""
+
+    stage: str
+    rank: int
+    architecture: str
+    cost: float
+    scaled_changes: float
+    scaled_delta_vg: float
+
+
+@dataclass(frozen=True, slots=True)
+class EstimateReport:
+    """``archmetrics estimate``: each architecture of a plan estimated against ``base``."""
+
+    plan: str
+    base: str
+    architectures: tuple[ArchitectureEstimate, ...]
+    gates: tuple[str, ...] = ()
+    failures: tuple[EstimateFailure, ...] = ()
+    actual: DiffReport | None = None  # --actual: the change measured afterwards
+    accuracy: tuple[tuple[str, ChangeAccuracy], ...] = ()  # per architecture, against it
+
+    def compare(self) -> CompareReport:
+        """The architectures as series side by side (what series and compare render)."""
+        return CompareReport(tuple((a.name, a.series) for a in self.architectures))
+
+    def stage_labels(self) -> tuple[str, ...]:
+        """Every stage label, in the order the architectures first name them."""
+        labels: dict[str, None] = {}
+        for architecture in self.architectures:
+            for stage in architecture.series.stages:
+                labels.setdefault(stage.label)
+        return tuple(labels)
+
+    def ranking(self) -> tuple[Ranked, ...]:
+        """Per stage, the architectures by total E, then by Γ'_tot (fewer changes first)."""
+        ranked: list[Ranked] = []
+        for label in self.stage_labels():
+            totals = [
+                (a.name, s.report.change.total)
+                for a in self.architectures
+                for s in a.series.stages
+                if s.label == label
+            ]
+            totals.sort(key=lambda item: (item[1].cost, item[1].scaled_changes, item[0]))
+            ranked += [
+                Ranked(label, i, name, t.cost, t.scaled_changes, t.scaled_delta_vg)
+                for i, (name, t) in enumerate(totals, start=1)
+            ]
+        return tuple(ranked)

@@ -10,11 +10,12 @@ from typing import Literal
 from rich.console import Console
 from rich.table import Table
 
-from archmetrics.reports import coupling_rows, diff_rows
+from archmetrics.reports import coupling_rows, diff_rows, estimate_rows
 from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
     DiffReport,
+    EstimateReport,
     ScanReport,
     SeriesReport,
 )
@@ -176,3 +177,49 @@ def render_compare(report: CompareReport, color: bool = False) -> str:
     names = ", ".join(name for name, _ in report.series)
     table = rows_table(f"compared: {names}", diff_rows.TREND_HEADER, rows, 3)
     return to_text(table, color=color)
+
+
+def render_estimate(report: EstimateReport, color: bool = False) -> str:
+    """Per stage: the per-location figures, one column group per architecture, and each
+    architecture's changed elements; then the ranking. Every title says it is an estimate."""
+    parts: list[object] = []
+    for label in report.stage_labels():
+        header = estimate_rows.summary_header(report, label)
+        title = f"archmetrics estimate ({estimate_rows.LABEL}): {report.plan} on {report.base}"
+        stage = "" if label == "estimate" else f", stage {label}"
+        # on a narrow terminal the totals stay longest: framework, base, then new go first
+        least_useful = [
+            h for where in (" framework", " base", " new") for h in header if h.endswith(where)
+        ]
+        rows = estimate_rows.summary_rows(report, label)
+        parts.append(rows_table(title + stage, tuple(header), rows, 2, None, least_useful))
+        element_header = ("architecture", *diff_rows.ELEMENT_HEADER)
+        rows = estimate_rows.element_rows(report, label)
+        if rows:
+            parts.append(rows_table("changed elements", element_header, rows, 4))
+    ranking = estimate_rows.ranking_rows(report)
+    parts.append(
+        rows_table("ranking: cheapest total E first", estimate_rows.RANKING_HEADER, ranking, 3)
+    )
+    parts += accuracy_parts(report)
+    lines = [
+        f"note {n}" for label in report.stage_labels() for n in estimate_rows.notes(report, label)
+    ]
+    lines += [str(f) for f in report.failures]
+    return to_text(*parts, color=color) + "".join(line + "\n" for line in lines)
+
+
+def accuracy_parts(report: EstimateReport) -> list[object]:
+    """--actual: each architecture's figures against the measured change."""
+    if report.actual is None:
+        return []
+    title = (
+        f"accuracy: the estimate against the measured {report.actual.base} → {report.actual.head}"
+    )
+    rows = estimate_rows.accuracy_rows(report)
+    parts: list[object] = [rows_table(title, estimate_rows.ACCURACY_HEADER, rows, 3)]
+    elements = estimate_rows.element_accuracy_rows(report)
+    if elements:
+        title = "elements: the figures the estimate got wrong"
+        parts.append(rows_table(title, estimate_rows.ELEMENT_ACCURACY_HEADER, elements, 4))
+    return parts
