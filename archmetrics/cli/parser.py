@@ -14,6 +14,7 @@ from archmetrics.reports.formats import Grouping, OutputFormat
 # What a suffix of --output means when --format is not given (an explicit --format wins).
 SUFFIX_FORMATS = {
     ".json": "json",
+    ".sarif": "sarif",
     ".md": "markdown",
     ".markdown": "markdown",
     ".csv": "csv",

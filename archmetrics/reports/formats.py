@@ -10,6 +10,7 @@ from archmetrics.reports import (
     csv_report,
     json_report,
     markdown_report,
+    sarif_report,
     table_report,
 )
 from archmetrics.reports.model import (
@@ -28,6 +29,7 @@ class OutputFormat(StrEnum):
     MARKDOWN = "markdown"
     CSV = "csv"
     CODECLIMATE = "codeclimate"  # GitLab Code Quality: failed gates and thresholds as issues
+    SARIF = "sarif"  # GitHub code scanning: the same findings as SARIF 2.1.0 results
 
 
 class Grouping(StrEnum):
@@ -47,15 +49,17 @@ _SCAN: dict[OutputFormat, ScanRenderer] = {
     OutputFormat.MARKDOWN: markdown_report.render_scan,
     OutputFormat.CSV: csv_report.render_scan,
     OutputFormat.CODECLIMATE: codeclimate_report.render_scan,
+    OutputFormat.SARIF: sarif_report.render_scan,
 }
 assert set(_SCAN) == set(OutputFormat), "every output format needs a scan renderer"
 
 
 def _safe(fmt: OutputFormat, text: str) -> str:
-    """JSON (and Code Climate's JSON, ASCII) escapes control characters itself; every other
-    format goes through
+    """JSON (and Code Climate's and SARIF's JSON, ASCII) escapes control characters itself;
+    every other format goes through
     :func:`~archmetrics.reports.printable.printable`."""
-    return text if fmt in (OutputFormat.JSON, OutputFormat.CODECLIMATE) else printable(text)
+    json_formats = (OutputFormat.JSON, OutputFormat.CODECLIMATE, OutputFormat.SARIF)
+    return text if fmt in json_formats else printable(text)
 
 
 def render_scan(report: ScanReport, fmt: OutputFormat, grouping: Grouping) -> str:
@@ -68,6 +72,7 @@ _DIFF: dict[OutputFormat, Callable[[DiffReport], str]] = {
     OutputFormat.MARKDOWN: markdown_report.render_diff,
     OutputFormat.CSV: csv_report.render_diff,
     OutputFormat.CODECLIMATE: codeclimate_report.render_diff,
+    OutputFormat.SARIF: sarif_report.render_diff,
 }
 assert set(_DIFF) == set(OutputFormat), "every output format needs a diff renderer"
 
@@ -86,6 +91,7 @@ _SERIES: dict[OutputFormat, Callable[[SeriesReport], str]] = {
     OutputFormat.MARKDOWN: markdown_report.render_series,
     OutputFormat.CSV: csv_report.render_series,
     OutputFormat.CODECLIMATE: codeclimate_report.render_series,
+    OutputFormat.SARIF: sarif_report.render_series,
 }
 _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
     OutputFormat.TABLE: table_report.render_compare,
@@ -93,6 +99,7 @@ _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
     OutputFormat.MARKDOWN: markdown_report.render_compare,
     OutputFormat.CSV: csv_report.render_compare,
     OutputFormat.CODECLIMATE: codeclimate_report.render_compare,
+    OutputFormat.SARIF: sarif_report.render_compare,
 }
 assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs series/compare"
 
@@ -113,6 +120,7 @@ _ESTIMATE: dict[OutputFormat, Callable[[EstimateReport], str]] = {
     OutputFormat.MARKDOWN: markdown_report.render_estimate,
     OutputFormat.CSV: csv_report.render_estimate,
     OutputFormat.CODECLIMATE: codeclimate_report.render_estimate,
+    OutputFormat.SARIF: sarif_report.render_estimate,
 }
 assert set(_ESTIMATE) == set(OutputFormat), "every output format needs an estimate renderer"
 
