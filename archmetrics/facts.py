@@ -74,13 +74,18 @@ class Decision(NamedTuple):
 
 
 class Function(NamedTuple):
-    """A function or method. ``complexity`` is McCabe's v_g = 1 + decision points."""
+    """A function or method. ``complexity`` is McCabe's v_g = 1 + decision points.
+
+    ``parameters``: the names of its parameters in the order written (Python's ``*args``
+    and ``**kw`` as ``args`` and ``kw``, ``self`` included; C's ``void`` list is empty),
+    so that a value can be traced from a call's argument to the parameter it binds."""
 
     name: str
     qualified_name: str
     span: Span
     decisions: tuple[Decision, ...]
     statements: int  # logical statements inside it, its signature included
+    parameters: tuple[str, ...] = ()
 
     @property
     def complexity(self) -> int:
@@ -118,6 +123,22 @@ class Dependency(NamedTuple):
     level: int = 0
     names: tuple[str, ...] = ()
     bound: tuple[str, ...] = ()
+
+
+class Binding(NamedTuple):
+    """A name given a value as written: ``PORT = 5555``, ``#define PORT "3490"``,
+    ``const char *port = getenv("P")``, ``fd = socket(...)`` (a plain name on the left of
+    ``=``, an initialized declarator, an object-like macro with a body).
+
+    ``value`` is the bound expression's normalized text (as statements' texts are
+    normalized); ``function`` the qualified name of the enclosing function, None at file,
+    namespace or class level. Coupling reads constants and traces endpoint values from these
+    (coupling/endpoints.py, coupling/trace.py), never from statement texts."""
+
+    name: str
+    value: str
+    line: int
+    function: str | None = None
 
 
 Literal = str | int | float | bool | None
@@ -253,8 +274,8 @@ def kept_digest(statements: Sequence[Statement]) -> str | None:
 class FileFacts:
     """Everything archmetrics knows about one file version.
 
-    ``statements`` and ``call_sites`` are tuples from a parser, :class:`Deferred` from the
-    cache."""
+    ``statements``, ``call_sites`` and ``bindings`` are tuples from a parser,
+    :class:`Deferred` from the cache."""
 
     path: str
     language: str
@@ -263,6 +284,7 @@ class FileFacts:
     classes: tuple[Class, ...] = ()
     dependencies: tuple[Dependency, ...] = ()
     call_sites: Sequence[CallSite] = ()
+    bindings: Sequence[Binding] = ()  # in source order
     sloc: int = 0  # physical lines that are neither blank nor only comment
     warnings: tuple[ParseWarning, ...] = ()
     parsed: bool = True  # False: the parser could not read it at all (reported, not guessed)

@@ -290,12 +290,13 @@ def _assigned_from(facts: FileFacts, call: CallSite, producers: Sequence[str]) -
     if first is None or not re.fullmatch(r"[A-Za-z_]\w*", first.text):
         return False
     names = "|".join(re.escape(p) for p in producers)
-    assignment = re.compile(rf"(?:^|[\s,(]){re.escape(first.text)} = (?:\( \w+ \) )?(?:{names}) \(")
+    produced = re.compile(rf"(?:\( \w+ \) )?(?:{names}) \(")  # (int) open ( ...
     return any(
-        s.function == call.function
-        and s.span.start <= call.span.start
-        and assignment.search(s.text)
-        for s in facts.statements
+        b.name == first.text
+        and b.function == call.function
+        and b.line <= call.span.start
+        and produced.match(b.value)
+        for b in facts.bindings
     )
 
 

@@ -15,14 +15,11 @@ import ast
 import re
 from collections.abc import Callable, Mapping, Sequence
 
-from archmetrics.facts import Argument, Statement
+from archmetrics.facts import Argument, Binding
 
 Value = str | int | float | bool | bytes | tuple[object, ...]
 Lookup = Callable[[str], Value | None]
 
-_DEFINE = re.compile(r"^#\s*define\s+([A-Za-z_]\w*)\s+(.+?)\s*$")
-_C_CONST = re.compile(r"^(?:[\w*\s]+?\s\**)([A-Za-z_]\w*)\s*(?:\[\s*\])?\s*=\s*(.+?)\s*;?\s*$")
-_PY_ASSIGN = re.compile(r"^([A-Za-z_]\w*)\s*(?::[^=]+)?=\s*(.+?)\s*$")
 _NAME = re.compile(r"^[A-Za-z_]\w*$")
 _PORT = re.compile(r":(\d{1,5})(?:/.*)?$")
 _ICE_PORT = re.compile(r"-p\s+(\d{1,5})\b")
@@ -41,22 +38,21 @@ def literal(text: str) -> Value | None:
     return value if isinstance(value, str | int | float | bool | bytes | tuple) else None
 
 
-def constants_of(statements: Sequence[Statement]) -> dict[str, Value]:
-    """File-level constants with literal values: ``#define``, C ``const`` and Python ``X = 1``."""
+def constants_of(bindings: Sequence[Binding]) -> dict[str, Value]:
+    """File-level constants with literal values: the file's bindings outside functions
+    (``#define PORT "3490"``, ``const int PORT = 3490;``, Python's ``PORT = 3490``) whose value
+    is a literal, or names another such constant (one level: ``#define PORT DEFAULT_PORT``).
+    The first binding of a name wins."""
     table: dict[str, Value] = {}
     aliases: dict[str, str] = {}
-    for statement in statements:
-        if statement.function is not None:
+    for binding in bindings:
+        if binding.function is not None or binding.name in table:
             continue
-        text = statement.text
-        match = _DEFINE.match(text) or _C_CONST.match(text) or _PY_ASSIGN.match(text)
-        if not match or match.group(1) in table:
-            continue
-        value = literal(match.group(2).rstrip(";"))
+        value = literal(binding.value)
         if value is not None:
-            table[match.group(1)] = value
-        elif _NAME.match(match.group(2)):
-            aliases[match.group(1)] = match.group(2)
+            table[binding.name] = value
+        elif _NAME.match(binding.value):
+            aliases[binding.name] = binding.value
     for name, other in aliases.items():  # one level of #define PORT DEFAULT_PORT
         if name not in table and other in table:
             table[name] = table[other]

@@ -74,7 +74,7 @@ class _Constants:
 
     def of(self, path: str) -> dict[str, Value]:
         if path not in self.tables:
-            self.tables[path] = constants_of(self.by_path[path].statements)
+            self.tables[path] = constants_of(self.by_path[path].bindings)
         return self.tables[path]
 
     def lookup(self, paths: Sequence[str]) -> Lookup:

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from archmetrics.coupling.endpoints import Lookup, Value, argument_value, literal, tuple_with_names
-from archmetrics.facts import Argument, FileFacts
+from archmetrics.facts import Argument, FileFacts, Language
 
 ArgumentReader = Callable[[Argument, str | None, int], tuple[Value | None, str]]
 """(argument, enclosing function, line) -> (value or None, how it was read)."""
@@ -26,7 +26,6 @@ _NAME = re.compile(r"^[A-Za-z_]\w*$")
 _IDENTIFIER = re.compile(r"[A-Za-z_]\w*")
 _STRING = re.compile(r"\"(?:\\.|[^\"\\])*\"|'(?:\\.|[^'\\])*'")
 _SELF = frozenset({"self", "cls"})
-_PYTHON_DEF = re.compile(r"^\s*(?:async\s+)?def\b")
 DEPTH = 3
 
 
@@ -68,16 +67,16 @@ class Tracer:
 
     @property
     def signatures(self) -> dict[str, _Signature]:
-        """Parameter names of the file's functions, read from their signatures on first use."""
+        """Parameter names of the file's functions (a Python method's ``self`` or ``cls``
+        left out: a call passes it before the parentheses)."""
         if self._signatures is None:
-            facts = self.facts
-            heads = {(st.function, st.span.start): st.text for st in facts.statements}
-            self._signatures = {
-                f.qualified_name: _Signature(
-                    f.name, _parameters(heads.get((f.qualified_name, f.span.start), ""), f.name)
-                )
-                for f in facts.functions
-            }
+            python = self.facts.language == Language.PYTHON
+            self._signatures = {}
+            for f in self.facts.functions:
+                names = f.parameters
+                if python and names and names[0] in _SELF:
+                    names = names[1:]
+                self._signatures[f.qualified_name] = _Signature(f.name, names)
         return self._signatures
 
     def read(self, argument: Argument, function: str | None, line: int) -> tuple[Value | None, str]:
@@ -118,15 +117,13 @@ class Tracer:
         return self._from_callers(signature, signature.parameters.index(name), depth - 1)
 
     def _assigned(self, name: str, function: str, line: int, depth: int) -> set[Value]:
-        pattern = re.compile(rf"(?<![\w.>])({re.escape(name)})\s*=(?!=)\s*(.+?)\s*;?\s*$")
+        """The values ``name`` is given in ``function`` up to ``line`` (its bindings)."""
         values: set[Value] = set()
-        for statement in self.facts.statements:
-            if statement.function != function or statement.span.start > line:
+        for binding in self.facts.bindings:
+            if binding.name != name or binding.function != function or binding.line > line:
                 continue
-            match = pattern.search(statement.text)
-            if not match:
-                continue
-            rhs = _split_top_level(match.group(2))[0].strip()  # int port = 6665 , opt ;
+            parts = _split_top_level(binding.value)  # Python's port = 6665, 6666
+            rhs = parts[0].strip() if parts else ""
             if value := self._expression(rhs, function, line, depth):
                 values.add(value)
         return values
@@ -160,29 +157,6 @@ class Tracer:
         if len(values) > 1:
             raise _Ambiguous(values)
         return values.pop() if values else None
-
-
-def _parameters(text: str, name: str) -> tuple[str, ...]:
-    start = text.find("(", max(text.find(name), 0))
-    if start < 0:
-        return ()
-    depth, inner = 0, []
-    for char in text[start + 1 :]:
-        depth += (char in "([{") - (char in ")]}")
-        if depth < 0:
-            break
-        inner.append(char)
-    python = _PYTHON_DEF.match(text) is not None
-    names: list[str] = []
-    for part in _split_top_level("".join(inner)):
-        part = part.split("=", 1)[0]
-        part = part.split(":", 1)[0] if python else part
-        identifiers = _IDENTIFIER.findall(re.sub(r"\[[^\]]*\]", "", part))
-        if identifiers:
-            names.append(identifiers[0] if python else identifiers[-1])
-    if python and names and names[0] in _SELF:
-        names = names[1:]
-    return tuple(names)
 
 
 def _split_top_level(text: str) -> list[str]:

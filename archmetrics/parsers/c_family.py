@@ -24,6 +24,7 @@ from archmetrics.facts import (
     Span,
 )
 from archmetrics.parsers import c_tables
+from archmetrics.parsers.c_family_bindings import bindings
 from archmetrics.parsers.c_family_branches import ALL, Conditionals, Group
 from archmetrics.parsers.c_family_calls import CallSites
 from archmetrics.parsers.c_family_definitions import Definition, definitions
@@ -41,6 +42,7 @@ from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
 from archmetrics.parsers.c_family_names import (
     Scopes,
     function_name,
+    function_parameters,
     in_order,
     typedef_names,
 )
@@ -66,6 +68,7 @@ class FunctionSlot:
     body_end: int
     decisions: list[Decision] = field(default_factory=list)
     statements: int = 0
+    parameters: tuple[str, ...] = ()
 
 
 def parse(
@@ -540,16 +543,19 @@ def _facts(
     )
     _decisions(found, owner, reading.directive_decisions)
     call_sites = CallSites(found.get("call", []), data).sites(owner.name)
+    bound = bindings(found.get("bind", []), clean, owner.name)
     return FileFacts(
         path=path,
         language=str(language),
         statements=tuple(facts_statements),
         functions=tuple(
-            Function(s.name, s.qualified, s.span, tuple(s.decisions), s.statements) for s in slots
+            Function(s.name, s.qualified, s.span, tuple(s.decisions), s.statements, s.parameters)
+            for s in slots
         ),
         classes=classes(found.get("class", []), scopes),
         dependencies=includes(nodes, data),
         call_sites=call_sites,
+        bindings=bound,
         sloc=sloc(clean),
         warnings=warnings(
             path,
@@ -637,8 +643,10 @@ def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> li
         if node.start_byte < last_end:
             continue
         prefix = prefixes[node.id]
+        parameters: tuple[str, ...] = ()
         if definition.macro is None:
             name, qualified = function_name(node, data, prefix)
+            parameters = function_parameters(node, data)
         else:
             name, qualified = definition.macro, f"{prefix}::{definition.macro}".lstrip(":")
         slots.append(
@@ -650,6 +658,7 @@ def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> li
                 definition.end,
                 body.start_byte,
                 body.end_byte,
+                parameters=parameters,
             )
         )
         last_end = definition.end

@@ -59,6 +59,8 @@ def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule])
         f"[{classes}] @class",
         f"({c_tables.NAMESPACE}) @namespace",
         "(call_expression) @call",
+        "[(init_declarator) (assignment_expression) (preproc_def)] @bind",
+        "(field_declaration default_value: (_)) @bind",  # c_family_bindings
         "(comment) @comment",
         "(ERROR) @error",
         "(MISSING) @missing",

@@ -157,6 +157,37 @@ def _name_text(node: Node, data: bytes) -> str:
         return "".join(prefix) + compact(text(node, data))[:_LONGEST_NAME]
 
 
+_PARAMETER_WRAPPERS = _DECLARATOR_WRAPPERS | {"array_declarator", "function_declarator"}
+
+
+def function_parameters(function: Node, data: bytes) -> tuple[str, ...]:
+    """The parameter names of a function definition, in order: `(const char *port, int
+    n)` gives `port`, `n`; a function pointer `void (*cb)(int)` gives `cb`; `(void)`, `...`
+    and unnamed parameters give nothing."""
+    node = function.child_by_field_name("declarator")
+    while node is not None and node.type in _DECLARATOR_WRAPPERS:
+        inner = node.child_by_field_name("declarator")
+        if inner is None and node.named_child_count:
+            inner = node.named_child(node.named_child_count - 1)
+        node = inner
+    if node is None or node.type != "function_declarator":
+        return ()
+    listed = node.child_by_field_name("parameters")
+    names: list[str] = []
+    for parameter in listed.named_children if listed is not None else ():
+        declarator = parameter.child_by_field_name("declarator")
+        for _ in range(64):  # nested declarators, never this deep in real code
+            if declarator is None or declarator.type not in _PARAMETER_WRAPPERS:
+                break
+            inner = declarator.child_by_field_name("declarator")
+            if inner is None and declarator.named_child_count:
+                inner = declarator.named_child(declarator.named_child_count - 1)
+            declarator = inner
+        if declarator is not None and declarator.type == "identifier":
+            names.append(compact(text(declarator, data)))
+    return tuple(names)
+
+
 def function_name(function: Node, data: bytes, prefix: str) -> tuple[str, str]:
     """(name, qualified name) of a function definition: `f`, `ns::Class::f` (``prefix``:
     the scopes around it, `ns::Class`)."""

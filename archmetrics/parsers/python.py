@@ -126,6 +126,7 @@ def parse_with_libcst(path: str, source: str, limits: ParseLimits = DEFAULT_LIMI
         call_sites=tuple(
             c.site() if isinstance(c, PendingCall) else c for c in walker.calls if c is not None
         ),
+        bindings=tuple(walker.bindings),
         sloc=walker.sloc(source),
     )
 

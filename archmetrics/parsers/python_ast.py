@@ -16,6 +16,7 @@ import unicodedata
 from collections.abc import Callable
 
 from archmetrics.facts import (
+    Binding,
     Class,
     Decision,
     Dependency,
@@ -33,6 +34,7 @@ from archmetrics.parsers.python_ast_rules import (
     docstring,
     statement_text,
 )
+from archmetrics.parsers.python_bindings import assignment_bindings
 from archmetrics.parsers.python_lex import Unreadable
 from archmetrics.parsers.python_shown import PendingCall
 
@@ -56,8 +58,18 @@ def read(path: str, source: str, tree: ast.Module) -> FileFacts:
         call_sites=tuple(
             call.site() if isinstance(call, PendingCall) else call for _, call in reader.calls
         ),
+        bindings=tuple(reader.bindings),
         sloc=reader.sloc(),
     )
+
+
+def parameters(args: ast.arguments) -> tuple[str, ...]:
+    """A def's parameter names in the order written (``*args`` as ``args``)."""
+    names = [a.arg for a in (*args.posonlyargs, *args.args)]
+    names += [args.vararg.arg] if args.vararg else []
+    names += [a.arg for a in args.kwonlyargs]
+    names += [args.kwarg.arg] if args.kwarg else []
+    return tuple(names)
 
 
 def _unnormalized_name(tokens: list[str]) -> bool:
@@ -79,6 +91,7 @@ class _Reader(ExpressionReader):
         self.functions: list[Function | None] = []
         self.classes: list[Class | None] = []
         self.dependencies: list[Dependency] = []
+        self.bindings: list[Binding] = []
         self.docstrings: list[tuple[int, int]] = []  # token ranges
 
     def statement_start(self, node: ast.stmt) -> int:
@@ -90,9 +103,13 @@ class _Reader(ExpressionReader):
 
     def add_statement(self, kind: str, first: int, end: int, node: ast.stmt | None = None) -> None:
         text = statement_text(self.tokens, first, end, node)
-        self.statements.append(Statement(kind, self.span(first, end), text, self.owner()))
+        span = self.span(first, end)
+        self.statements.append(Statement(kind, span, text, self.owner()))
         if self.funcs:
             self.funcs[-1].statements += 1
+        if kind == "assign" or kind == "annassign":
+            found = assignment_bindings(kind, self.tokens.text[first:end])
+            self.bindings += [Binding(n, v, span.start, self.owner()) for n, v in found]
 
     # -- blocks and simple statements -------------------------------------------------------
     def body(self, statements: list[ast.stmt], target: Frame | None, docstrings: bool) -> None:
@@ -251,7 +268,12 @@ class _Reader(ExpressionReader):
         frame.decisions.sort(key=lambda found: found[0])
         decisions = tuple(Decision(kind, line) for _, kind, line in frame.decisions)
         self.functions[slot] = Function(
-            node.name, frame.qualified_name, span, decisions, frame.statements
+            node.name,
+            frame.qualified_name,
+            span,
+            decisions,
+            frame.statements,
+            parameters(node.args),  # type: ignore[union-attr]
         )
 
     # -- SLOC -------------------------------------------------------------------------------

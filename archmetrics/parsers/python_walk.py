@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import libcst as cst
 
 from archmetrics.facts import (
+    Binding,
     CallSite,
     Class,
     Decision,
@@ -23,6 +24,7 @@ from archmetrics.facts import (
 )
 from archmetrics.parsers import python_calls as calls
 from archmetrics.parsers import python_rules as rules
+from archmetrics.parsers.python_bindings import assignment_bindings
 from archmetrics.parsers.python_shown import PendingCall, Shown, call_site
 from archmetrics.parsers.python_tokens import Hook, TokenState
 
@@ -54,6 +56,7 @@ class FactsWalker(TokenState):
         self.functions: list[Function | None] = []
         self.classes: list[Class | None] = []
         self.dependencies: list[Dependency] = []
+        self.bindings: list[Binding] = []
         self.calls: list[CallSite | PendingCall | None] = []
         self.docstrings: set[int] = set()
         self.elifs: set[int] = set()
@@ -77,11 +80,13 @@ class FactsWalker(TokenState):
 
     def add_statement(self, kind: str, first: int, end: int) -> None:
         """Record one logical line made of tokens ``first:end``."""
-        self.statements.append(
-            Statement(kind, self.span(first, end), self.text(first, end), self.owner())
-        )
+        span = self.span(first, end)
+        self.statements.append(Statement(kind, span, self.text(first, end), self.owner()))
         if self.funcs:
             self.funcs[-1].statements += 1
+        if kind == "assign" or kind == "annassign":
+            found = assignment_bindings(kind, self.toks[first:end])
+            self.bindings += [Binding(n, v, span.start, self.owner()) for n, v in found]
 
     def decide(self, kind: str) -> None:
         """A decision point at the next token (its line: that token's, also inside an
@@ -138,7 +143,7 @@ class FactsWalker(TokenState):
         decisions = tuple(Decision(kind, line) for kind, (line,) in frame.decisions)
         span = self.span(start, len(self.toks))
         self.functions[frame.slot] = Function(
-            frame.name, frame.qualified_name, span, decisions, frame.statements
+            frame.name, frame.qualified_name, span, decisions, frame.statements, parameters(node)
         )
 
     def enter_class(self, node: cst.ClassDef) -> None:
@@ -256,6 +261,18 @@ class FactsWalker(TokenState):
         span = Span(line, max(line, self.last_line(end)))
         made = PendingCall if long else call_site  # a long call's texts wait for all calls
         self.calls[slot] = made(self.shown, callee, name, receiver, span, arguments, self.owner())
+
+
+def parameters(node: cst.FunctionDef) -> tuple[str, ...]:
+    """A def's parameter names in the order written (``*args`` as ``args``)."""
+    params = node.params
+    names = [p.name.value for p in (*params.posonly_params, *params.params)]
+    if isinstance(params.star_arg, cst.Param):
+        names.append(params.star_arg.name.value)
+    names += [p.name.value for p in params.kwonly_params]
+    if params.star_kwarg is not None:
+        names.append(params.star_kwarg.name.value)
+    return tuple(names)
 
 
 def _decision(kind: str) -> Hook:

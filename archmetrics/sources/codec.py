@@ -1,14 +1,15 @@
 """FileFacts to and from compact JSON, for the cache. Never pickle: a cache file is not trusted.
 
-An entry is three JSON documents on three lines: everything but the call sites and the
-statements (the head), then the call sites, then the statements (the body). The facts
-cache keeps the head and the body apart (``split``): a look-up reads the head alone, and the
-body only when a file's statements or call sites are first used. ``decode`` reads the head
-and leaves the others as bytes until first read (:class:`~archmetrics.facts.Deferred`): a
-diff reads the statements of the files that changed, and coupling the call sites of files
-where a rule names one of their callees, and building those records was most of a warm
-diff's decode (docs/performance.md). The head holds the count and CRC-32 of each of the
-other two (so damage to them is found when they are read: then the cache forgets the
+An entry is four JSON documents on four lines: everything but the call sites, the statements
+and the bindings (the head), then the call sites, the statements and the bindings (the
+body). The facts cache keeps the head and the body apart (``split``): a look-up reads the
+head alone, and the body only when a file's statements, call sites or bindings are first
+used. ``decode`` reads the head and leaves the others as bytes until first read
+(:class:`~archmetrics.facts.Deferred`): a diff reads the statements of the files that
+changed, coupling the call sites of files where a rule names one of their callees and the
+bindings of the files it traces endpoints through, and building those records was most of
+a warm diff's decode (docs/performance.md). The head holds the count and CRC-32 of each of
+the other three (so damage to them is found when they are read: then the cache forgets the
 entry), the file's callees and the digest of its statements' kinds and texts (a file that
 changed only in layout or comments is then found unchanged without decoding its
 statements).
@@ -28,6 +29,7 @@ from typing import Any, ParamSpec, TypeVar
 
 from archmetrics.facts import (
     Argument,
+    Binding,
     CallSite,
     Class,
     Decision,
@@ -43,7 +45,8 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 6
+FORMAT = 7
+BODY_LINES = 3  # call sites, statements, bindings
 
 _new = tuple.__new__
 
@@ -68,11 +71,13 @@ def encode(facts: FileFacts) -> bytes:
     # records are named tuples: json writes each as a list in its fields' order, in C
     statements = _json(tuple(facts.statements))  # [kind, [start, end], text, function]
     calls = _json(tuple(facts.call_sites))  # [callee, name, receiver, span, arguments, fn]
+    bindings = _json(tuple(facts.bindings))  # [name, value, line, function]
     document = [
         FORMAT,
         facts.language,
         [len(facts.statements), zlib.crc32(statements), statements_digest(facts.statements)],
         [len(facts.call_sites), zlib.crc32(calls), sorted(facts.callees())],
+        [len(facts.bindings), zlib.crc32(bindings)],
         [
             [
                 f.name,
@@ -80,6 +85,7 @@ def encode(facts: FileFacts) -> bytes:
                 *_span(f.span),
                 f.statements,
                 [[d.kind, d.line] for d in f.decisions],
+                list(f.parameters),
             ]
             for f in facts.functions
         ],
@@ -93,8 +99,8 @@ def encode(facts: FileFacts) -> bytes:
         facts.parsed,
         facts.generated,
     ]
-    # three lines: JSON escapes the newlines inside strings
-    return b"\n".join((_json(document), calls, statements))
+    # four lines: JSON escapes the newlines inside strings
+    return b"\n".join((_json(document), calls, statements, bindings))
 
 
 class _Spans(dict[tuple[int, int], Span]):
@@ -114,7 +120,8 @@ Forget = Callable[[], None]
 
 
 def split(record: bytes) -> tuple[bytes, bytes]:
-    """A record's head (its first line) and its body (the call sites and statements)."""
+    """A record's head (its first line) and its body (the call sites, statements and
+    bindings)."""
     head, _, body = record.partition(b"\n")
     return head, body
 
@@ -165,8 +172,8 @@ def _reread(
 
     def payload() -> bytes:
         body = read()
-        lines = body.split(b"\n", 1) if body is not None else []
-        if len(lines) != 2 or zlib.crc32(lines[line]) != checksum:
+        lines = body.split(b"\n", 2) if body is not None else []
+        if len(lines) != BODY_LINES or zlib.crc32(lines[line]) != checksum:
             if forget is not None:
                 forget()
             raise CodecError(
@@ -190,6 +197,15 @@ def _statements(rows: list[list[Any]]) -> list[Statement]:
         _new(Statement, (intern(k), spans[a, b], intern(t), fn and intern(fn)))
         for k, (a, b), t, fn in rows
     ]
+
+
+def _bindings(rows: list[list[Any]]) -> list[Binding]:
+    made = [
+        _new(Binding, (intern(n), intern(v), line, fn and intern(fn))) for n, v, line, fn in rows
+    ]
+    if any(type(b.line) is not int for b in made):
+        raise ValueError("a binding's line is not a number")
+    return made
 
 
 def _calls(rows: list[list[Any]]) -> list[CallSite]:
@@ -244,17 +260,18 @@ def _malformed_is_codec_error(read: Callable[_P, _T]) -> Callable[_P, _T]:
 @_malformed_is_codec_error
 def _decode(
     head: bytes,
-    calls: bytes | None,
-    statements: bytes | None,
+    body: tuple[bytes, bytes, bytes] | None,
     path: str,
     again: Again | None,
     forget: Forget | None,
 ) -> FileFacts:
+    calls, statements, bindings = body if body is not None else (None, None, None)
     (
         fmt,
         language,
         (statement_count, statement_checksum, digest),
         (call_count, call_checksum, callees),
+        (binding_count, binding_checksum),
         functions,
         classes,
         deps,
@@ -289,9 +306,10 @@ def _decode(
                         spans[a, b],
                         tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
                         st,
+                        tuple([intern(p) for p in ps]),
                     ),
                 )
-                for n, q, a, b, st, ds in functions
+                for n, q, a, b, st, ds, ps in functions
             ]
         ),
         classes=tuple([Class(n, q, spans[a, b], k) for n, q, a, b, k in classes]),
@@ -311,6 +329,15 @@ def _decode(
             frozenset(intern(callee) for callee in callees),
             again=None if again is None else (again, 0, forget),
         ),
+        bindings=_deferred(
+            bindings,
+            binding_count,
+            binding_checksum,
+            "bindings",
+            path,
+            _bindings,
+            again=None if again is None else (again, 2, forget),
+        ),
         sloc=sloc,
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
         parsed=parsed,
@@ -324,13 +351,13 @@ def decode(
     """The facts ``encode`` wrote, now at ``path``; CodecError for anything else. ``again``:
     reads the record's body again (from the facts cache), so that the statements and call
     sites are not held as bytes until first read (their checksums are checked now and then)."""
-    lines = data.split(b"\n", 2)
-    if len(lines) != 3:
-        raise CodecError("not a facts record: not three lines")
-    return _decode(lines[0], lines[1], lines[2], path, again, forget)
+    lines = data.split(b"\n", 3)
+    if len(lines) != 1 + BODY_LINES:
+        raise CodecError(f"not a facts record: not {1 + BODY_LINES} lines")
+    return _decode(lines[0], (lines[1], lines[2], lines[3]), path, again, forget)
 
 
 def decode_head(head: bytes, path: str, again: Again, forget: Forget | None = None) -> FileFacts:
     """The facts of a record's head (``split``), their call sites and statements read by
     ``again`` on first use and checked then; CodecError for anything else."""
-    return _decode(head, None, None, path, again, forget)
+    return _decode(head, None, path, again, forget)

@@ -337,12 +337,13 @@ def test_damaged_statements_in_the_cache_are_a_one_line_error(
         " on b.blob=f.blob and b.language=f.language and b.parser=f.parser"
     ).fetchall()
     for head_row, body_row, head, body in rows:
-        calls, statements = body.split(b"\n")
+        calls, statements, bindings = body.split(b"\n")
         bad = statements.replace(b'"import"', b"1")  # well-formed JSON, not statements
         document = json.loads(head)
         document[2][1] = zlib.crc32(bad)  # a checksum that matches: found only when read
         db.execute("update facts set data=? where rowid=?", (_json(document), head_row))
-        db.execute("update bodies set data=? where rowid=?", (calls + b"\n" + bad, body_row))
+        damaged = b"\n".join((calls, bad, bindings))
+        db.execute("update bodies set data=? where rowid=?", (damaged, body_row))
     db.execute("delete from totals")  # the kept file changes: the statements must be read
     db.commit()
     db.close()

@@ -14,7 +14,8 @@ from archmetrics.coupling.dynamic import (
 from archmetrics.coupling.endpoints import chain_lookup, constants_of, literal, normalize
 from archmetrics.coupling.rules import EndpointSpec, FunctionHint, LinkKind, Role, Rule
 from archmetrics.coupling.trace import plain_reader
-from archmetrics.facts import Argument, CallSite, Span, Statement
+from archmetrics.facts import Argument, CallSite, Span
+from tests.harness import facts_of
 
 
 @pytest.mark.parametrize(
@@ -61,25 +62,27 @@ def test_literal_reads_c_and_python_spellings(text: str, value: object) -> None:
     assert literal(text) == value
 
 
-def _statement(text: str, function: str | None = None) -> Statement:
-    return Statement("define", Span(1, 1), text, function)
-
-
 def test_constants_come_from_file_level_definitions_only() -> None:
-    table = constants_of(
-        [
-            _statement('#define PORT "3490"'),
-            _statement("#define ALIAS PORT"),
-            _statement("#define MAX(a, b) ((a) > (b) ? (a) : (b))"),
-            _statement("static const int BACKLOG = 10 ;"),
-            _statement('static const char * HOST = "localhost" ;'),
-            _statement("TOPIC = 'pose'"),
-            _statement("LOCAL = 1", function="main"),
-        ]
+    c = facts_of(
+        """
+        #define PORT "3490"
+        #define ALIAS PORT
+        #define MAX(a, b) ((a) > (b) ? (a) : (b))
+        static const int BACKLOG = 10, QUEUE = 4;
+        static const char *HOST = "localhost";
+        int main(void) { int LOCAL = 1; return LOCAL; }
+        """,
+        "c",
     )
-    assert table == {
-        "PORT": "3490", "ALIAS": "3490", "BACKLOG": 10, "HOST": "localhost", "TOPIC": "pose",
+    assert constants_of(c.bindings) == {
+        "PORT": "3490", "ALIAS": "3490", "BACKLOG": 10, "QUEUE": 4, "HOST": "localhost",
     }  # fmt: skip
+    python = facts_of(
+        "TOPIC = 'pose'\nPAIR: tuple = ('', 5555)\nclass K:\n    RATE = 10\n"
+        "def f():\n    LOCAL = 1\n",
+        "python",
+    )
+    assert constants_of(python.bindings) == {"TOPIC": "pose", "PAIR": ("", 5555), "RATE": 10}
 
 
 @pytest.mark.parametrize(

@@ -8,7 +8,6 @@ from hypothesis import strategies as st
 from archmetrics.coupling.dynamic import matches, normalize_callee
 from archmetrics.coupling.endpoints import literal, normalize
 from archmetrics.coupling.rules import ENDPOINT_TYPES
-from archmetrics.coupling.trace import _parameters
 
 
 @given(st.text(max_size=60))
@@ -29,8 +28,3 @@ def test_normalize_callee_is_idempotent_and_a_callee_matches_itself_as_a_pattern
     assert normalize_callee(once) == once
     if once and not any(c in once for c in "*?[]"):
         assert matches(once, text)
-
-
-@given(st.text(max_size=80), st.text(max_size=10))
-def test_parameters_never_raise(signature: str, name: str) -> None:
-    assert all(isinstance(p, str) for p in _parameters(signature, name))

@@ -15,6 +15,7 @@ import pytest
 
 from archmetrics.facts import (
     Argument,
+    Binding,
     CallSite,
     Class,
     Decision,
@@ -40,7 +41,9 @@ SAMPLE = FileFacts(
         Statement("assign", Span(1, 2), "x = 1", None),
         Statement("def", Span(3, 3), "def f ( ) :", "f"),
     ),
-    functions=(Function("f", "f", Span(3, 5), (Decision("if", 4), Decision("and", 4)), 3),),
+    functions=(
+        Function("f", "f", Span(3, 5), (Decision("if", 4), Decision("and", 4)), 3, ("a", "b")),
+    ),
     classes=(Class("C", "C", Span(6, 9), "class"),),
     dependencies=(Dependency("", DependencyKind.IMPORT, Span(1, 1), 2, ("m", "n"), ("m", "o")),),
     call_sites=(
@@ -58,6 +61,7 @@ SAMPLE = FileFacts(
             "f",
         ),
     ),
+    bindings=(Binding("x", "1", 1), Binding("y", "( x , 2 )", 4, "f")),
     sloc=7,
     warnings=(ParseWarning("a/b.py", 3, "odd", Severity.ERROR),),
     parsed=True,
@@ -110,27 +114,29 @@ def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types
     assert first.statements[1].text is again.statements[1].text  # texts are interned
 
 
-def _parts() -> tuple[list[Any], bytes, bytes]:
-    head, calls, statements = codec.encode(SAMPLE).split(b"\n")
-    return json.loads(head), calls, statements
+def _parts() -> tuple[list[Any], bytes, bytes, bytes]:
+    head, calls, statements, bindings = codec.encode(SAMPLE).split(b"\n")
+    return json.loads(head), calls, statements, bindings
 
 
-def _joined(document: list[Any], calls: bytes, statements: bytes) -> bytes:
-    return b"\n".join((json.dumps(document).encode(), calls, statements))
+def _joined(document: list[Any], calls: bytes, statements: bytes, bindings: bytes) -> bytes:
+    return b"\n".join((json.dumps(document).encode(), calls, statements, bindings))
 
 
 def _tampered(edit: str) -> bytes:
-    document, calls, statements = _parts()
+    document, calls, statements, bindings = _parts()
     if edit == "statement":  # a statement starting on line 0, the checksum left as it was
         statements = statements.replace(b'"assign",[1,2]', b'"assign",[0,2]')
     elif edit == "call":  # an argument with two fields of four
         calls = calls.replace(b'["x",null,false,"timeout"]', b'["x",null]')
+    elif edit == "binding":  # a binding whose line is text, the checksum left as it was
+        bindings = bindings.replace(b'"1",1,', b'"1","1",')
     else:
-        document[4][0][2] = 0  # a function starting on line 0
-    return _joined(document, calls, statements)
+        document[5][0][2] = 0  # a function starting on line 0
+    return _joined(document, calls, statements, bindings)
 
 
-@pytest.mark.parametrize("edit", ["statement", "call", "function"])
+@pytest.mark.parametrize("edit", ["statement", "call", "binding", "function"])
 def test_codec_rejects_tampered_records(edit: str) -> None:
     assert _tampered(edit) != codec.encode(SAMPLE)
     with pytest.raises(codec.CodecError):
@@ -147,23 +153,28 @@ def test_statements_and_calls_are_decoded_when_first_read() -> None:
     assert facts.statements == SAMPLE.statements and facts == SAMPLE
 
 
-@pytest.mark.parametrize("part", ["statements", "call sites"])
+@pytest.mark.parametrize("part", ["statements", "call sites", "bindings"])
 def test_records_damaged_behind_a_good_checksum_fail_when_read(part: str) -> None:
-    document, calls, statements = _parts()
+    document, calls, statements, bindings = _parts()
     if part == "statements":
         statements = statements.replace(b'"assign",[1,2]', b'"assign",[0,2]')
         document[2][1] = zlib.crc32(statements)
-    else:
+    elif part == "call sites":
         calls = calls.replace(b'"bus.request","request"', b'"bus.request",7')
         document[3][1] = zlib.crc32(calls)
-    facts = codec.decode(_joined(document, calls, statements), "x.py")
-    assert facts.loc == 2 and len(facts.call_sites) == 1
+    else:
+        bindings = bindings.replace(b'"1",1,', b'"1","1",')
+        document[4][1] = zlib.crc32(bindings)
+    facts = codec.decode(_joined(document, calls, statements, bindings), "x.py")
+    assert facts.loc == 2 and len(facts.call_sites) == 1 and len(facts.bindings) == 2
+    read = {"statements": facts.statements, "call sites": facts.call_sites}.get(part)
     with pytest.raises(codec.CodecError, match=rf"bad {part} in the cached facts of x\.py"):
-        list(facts.statements if part == "statements" else facts.call_sites)
+        list(facts.bindings if read is None else read)
 
 
 @pytest.mark.parametrize(
-    "bad", [b"", b"[]", b"{}", b"[3]\n[]\n[]", b"not json", b'[3, "python"]\n[]\n[]', b"\n\n"]
+    "bad",
+    [b"", b"[]", b"{}", b"[7]\n[]\n[]\n[]", b"not json", b'[7, "python"]\n[]\n[]\n[]', b"\n\n\n"],
 )
 def test_codec_rejects_what_it_did_not_write(bad: bytes) -> None:
     with pytest.raises(codec.CodecError):

@@ -1,0 +1,86 @@
+"""C and C++ bindings (facts.Binding): what names are given which values, as written.
+
+Three shapes, captured by the query (``@bind``): an object-like macro with a body
+(``#define PORT "3490"``), an initialized declarator with ``=`` (``const char *port =
+getenv("P")``, every declarator of ``int a = 1, b = 2;``, at any scope, a class member's
+``static constexpr int P = 7;`` too) and a plain
+assignment to a name (``fd = socket(...)``, also inside a condition:
+``if ((fd = open(p)) < 0)``). The declared name is found through pointer, array, reference
+and parenthesized declarators; brace and constructor initializers (``int x{5}``,
+``std::string s("x")``) and compound assignments (``+=``) bind nothing. The value's text is
+normalized as statement texts are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from tree_sitter import Node
+
+from archmetrics.facts import Binding
+from archmetrics.parsers.c_family_names import in_order
+from archmetrics.parsers.c_family_text import compact, normal_many
+
+_WRAPPERS = frozenset(
+    {"pointer_declarator", "array_declarator", "reference_declarator", "parenthesized_declarator"}
+)
+_NOT_ASSIGNED = frozenset({"argument_list", "initializer_list"})
+_NAMES = frozenset({"identifier", "field_identifier"})
+
+
+def _declared(declarator: Node | None) -> Node | None:
+    """The identifier a declarator declares, through the declarators that wrap it."""
+    for _ in range(64):  # ``int *(*(*p))`` nests, but never this deep in real code
+        if declarator is None or declarator.type in _NAMES:
+            return declarator
+        if declarator.type not in _WRAPPERS:
+            return None
+        inner = declarator.child_by_field_name("declarator")
+        declarator = inner if inner is not None else declarator.named_child(0)
+    return None
+
+
+def _parts(node: Node) -> tuple[Node | None, Node | None]:
+    """(name, value) of one captured node, or Nones when it binds no plain name."""
+    kind = node.type
+    if kind == "preproc_def":
+        return node.child_by_field_name("name"), node.child_by_field_name("value")
+    if kind == "init_declarator" or kind == "field_declaration":
+        value = node.child_by_field_name("value" if kind[0] == "i" else "default_value")
+        if value is None or value.type in _NOT_ASSIGNED:
+            return None, None
+        return _declared(node.child_by_field_name("declarator")), value
+    operator = node.child_by_field_name("operator")
+    if operator is None or operator.type != "=":
+        return None, None
+    left = node.child_by_field_name("left")
+    return (left if left is not None and left.type == "identifier" else None), (
+        node.child_by_field_name("right")
+    )
+
+
+def bindings(
+    captured: list[Node], clean: bytes, owner: Callable[[int], str | None]
+) -> tuple[Binding, ...]:
+    """The bindings of the captured nodes in source order; ``clean``: the file with comments
+    blanked; ``owner``: the enclosing function's qualified name at a byte offset."""
+    found: list[tuple[str, int, str | None]] = []
+    values: list[bytes] = []
+    for node in in_order(captured):
+        name, value = _parts(node)
+        if name is None or value is None:
+            continue
+        found.append(
+            (
+                compact(clean[name.start_byte : name.end_byte]),
+                node.start_point.row + 1,
+                owner(node.start_byte),
+            )
+        )
+        values.append(clean[value.start_byte : value.end_byte])
+    texts = normal_many(values)
+    return tuple(
+        Binding(name, text, line, function)
+        for (name, line, function), text in zip(found, texts, strict=True)
+        if text
+    )
