@@ -48,11 +48,11 @@ def outcome(report: StudyReport, variant: str, finding: Finding) -> Outcome:
 
 
 def cause_text(o: Outcome, variant: str, causes: Mapping[tuple[str, str], Cause]) -> str:
-    """The cause beside a disagreement; nothing beside an agreement; why not measured."""
+    """The recorded cause beside a disagreement; nothing beside an agreement or no verdict."""
     if o.verdict.agrees is True:
         return ""
     if o.verdict.agrees is None:
-        return o.verdict.measured
+        return ""  # "measured" says why nothing was measured
     cause = causes.get((o.finding.id, variant))
     return cause.describe() if cause else "not yet analysed (no cause recorded)"
 
