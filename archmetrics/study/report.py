@@ -8,6 +8,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from archmetrics.changeset.model import Metrics
 from archmetrics.reports import diff_rows
 from archmetrics.reports.json_report import compare_dict
 from archmetrics.reports.markdown_report import table
@@ -158,6 +159,66 @@ def _measured_rows(report: StudyReport, causes: Mapping[tuple[str, str], Cause])
     return rows
 
 
+APPENDIX_HEADER = (
+    "approach",
+    "stage",
+    "element",
+    "location",
+    "status",
+    "λ_pre",
+    "λ_post",
+    "added",
+    "removed",
+    "modified",
+    "v_g pre",
+    "v_g post",
+    "s_a",
+    "s_e",
+    "d_a",
+    "d_e",
+)
+
+
+def appendix_rows(compare: CompareReport) -> list[list[str]]:
+    """Every element of every approach and stage (the thesis's appendices C-I): its change set,
+    its size and complexity before and after, and its coupling after (before, if removed).
+    Elements that are empty and unchanged are left out."""
+    rows = []
+    for approach, series in compare.series:
+        for stage in series.stages:
+            for e in stage.report.change.elements:
+                pre, post = e.pre or Metrics(), e.post or Metrics()
+                if e.status.value == "unchanged" and post.loc == 0:
+                    continue
+                coupling = post if e.post is not None else pre
+                rows.append(
+                    [
+                        approach,
+                        stage.label,
+                        e.element,
+                        e.location.value,
+                        e.status.value,
+                        *map(
+                            str,
+                            (
+                                pre.loc,
+                                post.loc,
+                                e.added,
+                                e.removed,
+                                e.modified,
+                                pre.vg,
+                                post.vg,
+                                coupling.s_a,
+                                coupling.s_e,
+                                coupling.d_a,
+                                coupling.d_e,
+                            ),
+                        ),
+                    ]
+                )
+    return rows
+
+
 def render_markdown(
     report: StudyReport, causes: Mapping[tuple[str, str], Cause], charts: dict[str, list[str]]
 ) -> str:
@@ -192,4 +253,15 @@ def render_markdown(
             parts.append(table(list(diff_rows.TREND_HEADER), rows, "lll" + "r" * 10))
             for image in charts.get(f"{result.variant}/{r.subject}", []):
                 parts.append(f"![{image}](charts/{image})\n")
+    parts.append("## Appendix: every element, stage by stage\n")
+    parts.append(
+        "The thesis's appendices C-I, per variant, subject, approach and stage: each element's "
+        "change set (statements added, removed, modified), logical lines λ and McCabe v_g "
+        "before and after, and its coupling after the stage. The location rows above sum "
+        "these; report.json has the same under each stage's `elements`.\n"
+    )
+    for result in report.variants:
+        for r in result.subjects:
+            parts.append(f"### `{r.subject}`, {result.variant}\n")
+            parts.append(table(list(APPENDIX_HEADER), appendix_rows(r.compare), "l" * 5 + "r" * 11))
     return "\n".join(parts)

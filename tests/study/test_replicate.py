@@ -158,3 +158,24 @@ def test_an_unknown_subject_is_a_one_line_error(capsys: pytest.CaptureFixture[st
         err
         == "archmetrics: error: no study subject 'foo'; the subjects are: legacy, pragmatics, wdb"
     )
+
+
+def test_the_appendix_lists_every_element_and_sums_to_the_locations(
+    study: Path, report: Any
+) -> None:
+    """report.md's appendix (the thesis's appendices C-I): the framework elements of one stage
+    add up to the framework location's change count and v_g in report.json."""
+    markdown = (study / "report.md").read_text()
+    appendix = markdown[markdown.index("## Appendix: every element") :]
+    section = appendix[appendix.index("### `wdb`, idiomatic") :]
+    section = section.split("\n### ")[0]
+    rows = [
+        [cell.strip() for cell in line.strip("|").split("|")]
+        for line in section.splitlines()
+        if line.startswith("| p2p | first |")
+    ]
+    framework = [row for row in rows if row[3] == "framework"]
+    assert [row[2] for row in framework] == ["server/wdb-server"]  # element: the file, no suffix
+    expected = _total(report, "wdb", "p2p", "first", "framework")
+    assert sum(int(row[7]) + int(row[8]) + int(row[9]) for row in framework) == expected["changes"]
+    assert sum(int(row[11]) - int(row[10]) for row in framework) == expected["delta_vg"]
