@@ -12,6 +12,7 @@ import ast
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -19,8 +20,9 @@ from pathlib import Path
 import pytest
 
 from archmetrics.study.manifest import load_manifest
-from tests.robosoa.procs import Proc, tcp_location
+from tests.robosoa.procs import Proc, free_port, tcp_location
 from tests.study.test_pragmatics_subjects import DRIVE, REPORT, TURNS, Expect
+from tests.study.test_wdb_subjects import Proc as ChildProc
 
 REPO = Path(__file__).resolve().parents[2]
 DESCRIBED = REPO / "fixtures" / "study" / "as-described" / "pragmatics"
@@ -171,3 +173,95 @@ def test_soa_stage_on_zmq_bus(stage: str) -> None:
     finally:
         for proc in reversed(started):
             proc.stop()
+
+
+# ---- P2P: p. 120, 132, 135 ------------------------------------------------------------------
+
+P2P_HANDLERS = {  # per stage: each component's handlers, one per message it sends or receives
+    "baseline": {"muri-backend.c": [], "muri-prag.c": [], "gui-prag.c": []},
+    "first": {"muri-backend.c": ["serve_translate"],
+              "muri-prag.c": ["serve_drive", "serve_translated"],
+              "gui-prag.c": ["send_drive", "await_drove"]},
+    "second": {"muri-backend.c": ["serve_translate", "serve_rotate"],
+               "muri-prag.c": ["serve_drive", "serve_translated", "serve_turn", "serve_rotated"],
+               "gui-prag.c": ["send_drive", "await_drove", "send_turn", "await_turned"]},
+}
+
+
+def _c_function(text: str, name: str) -> str:
+    start = text.index(f" {name}(")
+    return text[start : text.index("\n}\n", start)]
+
+
+@pytest.mark.parametrize("stage", STAGES)
+def test_p2p_every_message_has_its_own_accept_recv_and_send(stage: str) -> None:
+    """P. 132: "the addition of accept, recv, and send operations for each of the GUI,
+    Pragmatics, and Backend components"."""
+    root = stage_dir("p2p", stage)
+    for file, handlers in P2P_HANDLERS[stage].items():
+        text = (root / file).read_text(encoding="utf-8")
+        for name in handlers:
+            body = _c_function(text, name)
+            calls = {"send": ("send(",), "await": ("accept(", "recv(")}.get(
+                name.split("_")[0], ("accept(", "recv(", "send("))
+            for call in calls:
+                found = body.count(f" {call}") + body.count(f"({call}")
+                assert found == 1, (file, name, call)
+        for call in ("accept(", "recv("):
+            receivers = [h for h in handlers if not h.startswith("send_")]
+            assert text.count(f"{call}") == len(receivers), (file, call)
+
+
+def _compile(output: Path, *sources: Path) -> None:
+    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-o", str(output),
+                           *map(str, sources), "-lm"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler")
+@pytest.mark.parametrize("stage", STAGES)
+def test_p2p_stage_remaps_commands_and_status(stage: str, tmp_path: Path) -> None:
+    root = stage_dir("p2p", stage)
+    backend, prag, gui = tmp_path / "muri-backend", tmp_path / "muri-prag", tmp_path / "gui-prag"
+    _compile(backend, root / "muri-backend.c", root / "backend" / "motion.c")
+    remap = [root / "pragmatics" / "remap.c"] if stage != "baseline" else []
+    _compile(prag, root / "muri-prag.c", *remap)
+    _compile(gui, root / "gui-prag.c")
+    env = {**os.environ, "MURI_PORT_BASE": str(_free_port_block()), "MURI_PEER_HOST": "127.0.0.1",
+           "MURI_REPLY_TIMEOUT": "10"}
+    started: list[ChildProc] = []
+    try:
+        for program in (backend, prag):
+            log = tmp_path / f"{program.name}.log"
+            started.append(ChildProc([str(program)], tmp_path, env, log))
+            started[-1].wait_line("waiting for messages", timeout=TIMEOUT)
+        done = subprocess.run([str(gui)], input="\n".join(commands(stage)) + "\n", env=env,
+                              capture_output=True, text=True, timeout=TIMEOUT)  # fmt: skip
+        check_output(stage, done.returncode, done.stdout.splitlines())
+    finally:
+        for proc in reversed(started):
+            proc.stop()
+
+
+def _free_port_block() -> int:
+    """A base port whose message offsets (0-1, 10-11, 20-21, 30-31) were all free just now."""
+    import socket
+
+    for _ in range(50):
+        base = free_port()
+        if base + 31 > 65535:
+            continue
+        ports = [base + offset for offset in (0, 1, 10, 11, 20, 21, 30, 31)]
+        try:
+            socks = []
+            for port in ports:
+                sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+                socks.append(sock)
+                sock.bind(("127.0.0.1", port))
+            return base
+        except OSError:
+            continue
+        finally:
+            for sock in socks:
+                sock.close()
+    raise AssertionError("no free block of ports")
