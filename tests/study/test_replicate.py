@@ -120,6 +120,10 @@ def test_the_repositories_have_a_tag_per_stage(built: tuple[Path, Path]) -> None
 def test_manifests_load_and_become_settings() -> None:
     manifests = find_manifests(subjects_root())
     assert sum(m.variant == "idiomatic" for m in manifests) == 7
+    described = sorted((m.subject, m.approach) for m in manifests if m.variant == "as-described")
+    assert described == sorted((m.subject, m.approach) for m in manifests
+                               if m.variant == "idiomatic")  # fmt: skip
+    assert all(len(m.follows) == len(m.stages) for m in manifests if m.variant == "as-described")
     wdb_soa = next(m for m in manifests if (m.subject, m.approach) == ("wdb", "soa"))
     settings = settings_for(wdb_soa)
     assert settings.locations.new == ("wdb/**",) and not settings.include_generated
