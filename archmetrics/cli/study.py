@@ -65,10 +65,13 @@ def _unmeasured(variant: VariantResult) -> int:
 def findings_summary(
     report: StudyReport, causes: Mapping[tuple[str, str], Cause], out: Path
 ) -> str:
+    from rich.markup import escape
+
     from archmetrics.reports.table_report import rows_table, to_text
     from archmetrics.study.report import FINDINGS_HEADER, agreements, findings_rows
 
-    rows = findings_rows(report, causes)
+    # the causes name elements in [brackets], which rich would take for markup
+    rows = [[escape(cell) for cell in row] for row in findings_rows(report, causes)]
     title = "the thesis's findings on both variants of the subjects"
     table = rows_table(title, FINDINGS_HEADER, rows, 5)
     said = "; ".join(

@@ -183,3 +183,14 @@ def test_the_appendix_lists_every_element_and_sums_to_the_locations(
     expected = _total(report, "wdb", "p2p", "first", "framework")
     assert sum(int(row[7]) + int(row[8]) + int(row[9]) for row in framework) == expected["changes"]
     assert sum(int(row[11]) - int(row[10]) for row in framework) == expected["delta_vg"]
+
+
+def test_the_printed_table_keeps_the_elements_a_cause_names(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Causes name elements in [brackets]; the terminal table prints them (not as markup)."""
+    out = tmp_path / "out"
+    assert main(["replicate", "--subject", "legacy", "--out", str(out), "--no-charts",
+                 "--quiet"]) == 0  # fmt: skip
+    printed = capsys.readouterr().out
+    assert "idiomatic disagrees" in printed and "[p2d_service/*.py," in printed
