@@ -2,7 +2,8 @@
 
 Runs ``archmetrics replicate`` in process (the same use case as the CLI) and rewrites every
 region of docs/study.md between ``<!-- generated:NAME -->`` and ``<!-- /generated:NAME -->``:
-``findings`` (the verdicts) and one region per subject (per approach, stage and location).
+``findings`` (the verdicts on both variants) and one region per variant and subject
+(``<variant>-<subject>``: per approach, stage and location).
 Numbers in those regions are never edited by hand.
 
 usage: .venv/bin/python docs/study_tables.py [docs/study.md]
@@ -16,8 +17,10 @@ from pathlib import Path
 from archmetrics.app.replicate import ReplicateRequest, run_replicate, subjects_root
 from archmetrics.changeset.model import Summary
 from archmetrics.reports.model import SeriesReport
-from archmetrics.study.findings import INTEGRATION, summary
-from archmetrics.study.report import StudyReport, verdict_word
+from archmetrics.study.causes import load_causes
+from archmetrics.study.findings import FINDINGS, INTEGRATION, summary
+from archmetrics.study.manifest import VARIANTS
+from archmetrics.study.report import StudyReport, cause_text, outcome, verdict_word
 
 LOCATIONS = ("base", "framework", INTEGRATION, "new", "total")
 LABEL = {INTEGRATION: "base + framework"}
@@ -35,9 +38,18 @@ def _number(value: float | None) -> str:
 
 def _row(approach: str, stage: str, location: str, s: Summary) -> str:
     cells = (
-        s.delta_s_a, s.delta_s_e, s.delta_d_a, s.delta_d_e, s.loc_pre, s.loc_post,
-        s.changes, s.scaled_changes, s.delta_vg, s.scaled_delta_vg, s.cost,
-    )  # fmt: skip
+        s.delta_s_a,
+        s.delta_s_e,
+        s.delta_d_a,
+        s.delta_d_e,
+        s.loc_pre,
+        s.loc_post,
+        s.changes,
+        s.scaled_changes,
+        s.delta_vg,
+        s.scaled_delta_vg,
+        s.cost,
+    )
     where = LABEL.get(location, location)
     return f"| {approach} | {stage} | {where} | " + " | ".join(map(_number, cells)) + " |"
 
@@ -54,18 +66,33 @@ def subject_table(series: dict[str, SeriesReport]) -> str:
 
 
 def findings_table(report: StudyReport) -> str:
-    """The verdict of every finding and what was measured, as replicate reports them."""
-    lines = ["| finding | verdict | we measured |", "| --- | --- | --- |"]
-    for outcome in report.outcomes:
-        word = verdict_word(outcome.verdict.agrees)
-        lines.append(f"| {outcome.finding.id} | {word} | {outcome.verdict.measured} |")
+    """The verdict of every finding on each variant, what was measured and the recorded cause,
+    as replicate reports them."""
+    causes = load_causes()
+    lines = [
+        "| finding | variant | verdict | we measured | cause |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for finding in FINDINGS:
+        for variant in VARIANTS:
+            o = outcome(report, variant, finding)
+            cells = (
+                finding.id,
+                variant,
+                verdict_word(o.verdict.agrees),
+                o.verdict.measured,
+                cause_text(o, variant, causes),
+            )
+            lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     return "\n".join(lines)
 
 
 def regions(report: StudyReport) -> dict[str, str]:
     found = {"findings": findings_table(report)}
-    for result in report.subjects:
-        found[result.subject] = subject_table(dict(result.compare.series))
+    for variant in report.variants:
+        for result in variant.subjects:
+            name = f"{variant.variant}-{result.subject}"
+            found[name] = subject_table(dict(result.compare.series))
     return found
 
 

@@ -46,6 +46,7 @@ def test_wheel_contents(wheel: Path) -> None:
         "archmetrics/data/sample/python/odometry.py",
         "archmetrics/coupling/rules/posix-sockets.toml",
         "archmetrics/study_subjects/wdb/soa/manifest.toml",
+        "archmetrics/study/causes.toml",
         "archmetrics/study_subjects/player_stub/libplayerc/playerc.h",
         "robosoa/data/descriptor.xsd",
         "archmetrics/schemas/scan-1.schema.json",
@@ -97,9 +98,9 @@ def test_replicate_runs_from_the_installed_wheel(wheel: Path, tmp_path: Path) ->
         timeout=900,
     )
     assert done.returncode == 0, done.stderr
-    assert "findings agree" in done.stdout
+    assert "idiomatic: " in done.stdout and " of 11 agree" in done.stdout
     report = json.loads((tmp_path / "study" / "report.json").read_text())
-    assert report["schema"] == "archmetrics.study/1"
-    assert set(report["subjects"]) == {"wdb", "pragmatics", "legacy"}
+    assert report["schema"] == "archmetrics.study/2"
+    assert set(report["variants"]["idiomatic"]["subjects"]) == {"wdb", "pragmatics", "legacy"}
     assert (tmp_path / "study" / "report.md").stat().st_size > 1000
-    assert list((tmp_path / "study" / "charts").glob("*.png"))
+    assert list((tmp_path / "study" / "charts" / "idiomatic").glob("*.png"))

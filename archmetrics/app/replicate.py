@@ -19,8 +19,8 @@ from archmetrics.config import LocationSettings, Settings
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.staging import build_stage_repository
 from archmetrics.study.findings import check_findings
-from archmetrics.study.manifest import Manifest, ManifestError, find_manifests
-from archmetrics.study.report import StudyReport, SubjectResult
+from archmetrics.study.manifest import VARIANTS, Manifest, ManifestError, find_manifests
+from archmetrics.study.report import StudyReport, SubjectResult, VariantResult
 
 
 def subjects_root() -> Path:
@@ -63,7 +63,7 @@ def _series_request(manifest: Manifest, repo: Path, jobs: int) -> SeriesRequest:
 def _build(manifests: Sequence[Manifest], where: Path) -> dict[Manifest, Path]:
     repos = {}
     for m in manifests:
-        dest = where / m.subject / m.approach
+        dest = where / m.variant / m.subject / m.approach
         build_stage_repository(dest, [(stage, m.stage_dir(stage)) for stage in m.stages])
         repos[m] = dest
     return repos
@@ -85,11 +85,34 @@ def run_replicate(
     with tempfile.TemporaryDirectory(prefix="archmetrics-study-") as scratch:
         where = request.keep_repositories or Path(scratch)
         repos = _build(manifests, where)
-        results = []
-        for subject in sorted({m.subject for m in manifests}):
-            ours = [m for m in manifests if m.subject == subject]
-            named = [(m.approach, _series_request(m, repos[m], request.jobs)) for m in ours]
-            compare = run_compare(named, progress, cache)
-            results.append(SubjectResult(subject, tuple(ours), compare))
+        variants = [
+            _measure_variant(
+                variant,
+                [m for m in manifests if m.variant == variant],
+                repos,
+                request.jobs,
+                progress,
+                cache,
+            )
+            for variant in VARIANTS
+        ]
+    return StudyReport(tuple(variants))
+
+
+def _measure_variant(
+    variant: str,
+    manifests: Sequence[Manifest],
+    repos: dict[Manifest, Path],
+    jobs: int,
+    progress: Progress | None,
+    cache: FactsCache | None,
+) -> VariantResult:
+    """Every subject of one variant compared across its approaches, and the findings checked."""
+    results = []
+    for subject in sorted({m.subject for m in manifests}):
+        ours = [m for m in manifests if m.subject == subject]
+        named = [(m.approach, _series_request(m, repos[m], jobs)) for m in ours]
+        compare = run_compare(named, progress, cache)
+        results.append(SubjectResult(subject, tuple(ours), compare))
     subjects = {r.subject: r.compare for r in results}
-    return StudyReport(tuple(results), check_findings(subjects))
+    return VariantResult(variant, tuple(results), check_findings(subjects))

@@ -99,7 +99,9 @@ def _wdb_soa_coupling(soa: SeriesReport) -> Verdict:
 
 @_series(["soa"])
 def _wdb_soa_zero_cost(soa: SeriesReport) -> Verdict:
-    parts, ok = [], True
+    """A high cost at the baseline (p. 120), zero in client and provider afterwards (p. 122)."""
+    initial = summary(soa, "baseline").cost
+    parts, ok = [f"baseline: E = {_fmt(initial)}"], initial > 0
     for stage in LATER:
         for loc in ("base", "framework"):
             s = summary(soa, stage, loc)
@@ -154,57 +156,83 @@ def _wdb_p2p_grows_most(found: Mapping[str, SeriesReport]) -> Verdict:
 
 
 def _prag_soa_largest_de(found: Mapping[str, SeriesReport]) -> Verdict:
+    """ "Relatively large for both integration phases" (p. 132): above zero, and not below every
+    other approach, at the first and the second stage."""
     if "soa" not in found or len(found) < 2:
         return Verdict(None, "not measured: needs soa and another approach")
-    ok, text = _largest("soa", "delta_d_e", LATER, found)
-    return Verdict(ok, text)
+    ok, parts = True, []
+    for stage in LATER:
+        values = {name: summary(s, stage).delta_d_e for name, s in found.items()}
+        others = [v for name, v in values.items() if name != "soa"]
+        ok = ok and values["soa"] > 0 and values["soa"] >= min(others)
+        parts.append(f"{stage} Δd_e: " + ", ".join(f"{n} {v}" for n, v in values.items()))
+    return Verdict(ok, "; ".join(parts))
 
 
 def _costs(series: SeriesReport) -> dict[str, float]:
     return {s.label: summary(series, s.label).cost for s in series.stages}
 
 
+def _costs_text(e: Mapping[str, float]) -> str:
+    return ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items())
+
+
+# One tolerance for every unquantified word of the thesis about E: "relatively constant"
+# (p. 133) and "near constant" (p. 142) mean within NEAR of each other; "large jump" (p. 135),
+# "drop sharply" (p. 135) and "increases significantly" (p. 135) mean a change beyond it.
+# Set to 1.25 before issue 15; since then applied to results already known (docs/study.md).
+NEAR = 1.25
+
+
+def near(a: float, b: float) -> bool:
+    """Whether two values of E are near constant: the larger within NEAR of the smaller."""
+    low, high = sorted((a, b))
+    return high <= NEAR * low
+
+
 @_series(["soa"])
 def _prag_soa_constant_cost(soa: SeriesReport) -> Verdict:
-    costs = _costs(soa)
-    values = list(costs.values())
-    ok = min(values) > 0 and max(values) / min(values) <= 1.5
-    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in costs.items()))
+    """Significant at the baseline, never rising beyond near constant afterwards (p. 142), and
+    "relatively constant" over the message additions (p. 133)."""
+    e = _costs(soa)
+    ok = (
+        min(e.values()) > 0 and e["first"] <= NEAR * e["baseline"] and near(e["first"], e["second"])
+    )
+    return Verdict(ok, _costs_text(e))
 
 
 @_series(["player"])
 def _prag_player_jump(player: SeriesReport) -> Verdict:
     e = _costs(player)
-    ok = e["first"] > e["baseline"] and e["second"] < e["first"]
-    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()))
+    ok = e["first"] > NEAR * e["baseline"] and NEAR * e["second"] < e["first"]
+    return Verdict(ok, _costs_text(e))
 
 
 def _prag_p2p_high_rising(found: Mapping[str, SeriesReport]) -> Verdict:
-    if "p2p" not in found:
-        return Verdict(None, "not measured: no p2p in this study")
+    if "p2p" not in found or len(found) < 2:
+        return Verdict(None, "not measured: needs p2p and another approach")
     e = _costs(found["p2p"])
     highest, text = _largest("p2p", "cost", ("second",), found)
-    ok = e["second"] > e["first"] and highest
-    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()) + f"; {text}")
-
-
-NEAR = 1.25  # "stabilizes at a near constant value" (p. 142): within 25 % of the stage before
+    ok = e["second"] > NEAR * e["first"] and highest
+    return Verdict(ok, _costs_text(e) + f"; {text}")
 
 
 @_series(["soa"])
 def _legacy_soa_cost(soa: SeriesReport) -> Verdict:
-    """Large at the baseline, then "decreases or stabilizes at a near constant value": no later
-    stage rises more than NEAR above the stage before it (a fall or a near-constant step)."""
+    """ "The initial complexity change cost is large": no later stage above the baseline; "but
+    decreases or stabilizes at a near constant value": the second stage falls below the first
+    or stays near it (p. 142)."""
     e = _costs(soa)
-    ok = e["first"] <= NEAR * e["baseline"] and e["second"] <= NEAR * e["first"]
-    return Verdict(ok, ", ".join(f"E({k}) = {_fmt(v)}" for k, v in e.items()))
+    initial_large = e["baseline"] > 0 and max(e["first"], e["second"]) <= e["baseline"]
+    settles = e["second"] <= e["first"] or near(e["first"], e["second"])
+    return Verdict(initial_large and settles, _costs_text(e))
 
 
 FINDINGS: tuple[Finding, ...] = (
     Finding(
         "wdb-soa-coupling",
         "wdb",
-        "SOA: coupling does not change after the baseline",
+        "SOA: the coupling does not change",
         "119",
         "Δs_a = Δs_e = Δd_a = Δd_e = 0 in base + framework at the first and second stages",
         _wdb_soa_coupling,
@@ -212,16 +240,17 @@ FINDINGS: tuple[Finding, ...] = (
     Finding(
         "wdb-soa-cost",
         "wdb",
-        "SOA: each added operation is about two client lines and one"
-        " dispatch line, so ΔVg = 0 and E = 0",
-        "122",
-        "ΔVg = 0 and E = 0 in base and framework at the first and second stages",
+        "SOA: a high cost for the baseline, then a zero complexity change cost (the added lines"
+        " are sequential)",
+        "120, 122",
+        "E(baseline) > 0 in base + framework; ΔVg = 0 and E = 0 in base and in framework at the"
+        " first and second stages",
         _wdb_soa_zero_cost,
     ),
     Finding(
         "wdb-player-coupling",
         "wdb",
-        "Player: each added message gives +1 static efferent and +2 dynamic efferent coupling",
+        "Player: each added message gives +1 static and +2 dynamic efferent coupling",
         "119-120",
         "Δs_e = 1 and Δd_e = 2 in base + framework at the first and second stages",
         _wdb_player_coupling,
@@ -229,7 +258,7 @@ FINDINGS: tuple[Finding, ...] = (
     Finding(
         "wdb-player-growth",
         "wdb",
-        "Player: code grows 30-40 lines a stage with scaled complexity near 6",
+        "Player: the code grows by 30 to 40 lines a stage with a scaled complexity of around 6",
         "122",
         "30 ≤ Γ ≤ 40 and 4.5 ≤ ΔVg' ≤ 7.5 in base + framework at the first and second stages",
         _wdb_player_growth,
@@ -237,7 +266,7 @@ FINDINGS: tuple[Finding, ...] = (
     Finding(
         "wdb-p2p-coupling",
         "wdb",
-        "P2P: +3 dynamic efferent coupling per message (accept, send, recv)",
+        "P2P: each new message adds an accept, send and recv: a constant +3 dynamic efferent",
         "120",
         "Δd_e = 3 in base + framework at the first and second stages",
         _wdb_p2p_coupling,
@@ -245,49 +274,55 @@ FINDINGS: tuple[Finding, ...] = (
     Finding(
         "wdb-p2p-growth",
         "wdb",
-        "P2P: size and complexity grow the most",
+        "P2P: size and complexity grow significantly with each integration",
         "122-123",
-        "P2P has the largest Γ' and ΔVg' in base + framework at the first and second stages",
+        "P2P's Γ' and ΔVg' in base + framework are the largest of the approaches (ties allowed)"
+        " at the first and second stages",
         _wdb_p2p_grows_most,
     ),
     Finding(
         "prag-soa-coupling",
         "pragmatics",
-        "SOA has the largest dynamic efferent coupling",
+        "SOA: the dynamic efferent coupling is relatively large for both integration phases",
         "132",
-        "SOA has the largest Δd_e in base + framework at the first and second stages",
+        "SOA's Δd_e in base + framework is > 0 and not below every other approach's, at the"
+        " first and second stages",
         _prag_soa_largest_de,
     ),
     Finding(
         "prag-soa-cost",
         "pragmatics",
-        "SOA: near-constant complexity change cost E across stages",
-        "133",
-        "E of base + framework > 0 at every stage, max/min ≤ 1.5",
+        "SOA: significant complexity, and E relatively constant over the stages; like the"
+        " other SOA integrations, large at first, then decreasing or stable",
+        "133, 142",
+        "in base + framework, E > 0 at every stage, E(first) ≤ 1.25·E(baseline), and E(first)"
+        " and E(second) within 1.25x of each other",
         _prag_soa_constant_cost,
     ),
     Finding(
         "prag-player-cost",
         "pragmatics",
-        "Player: E jumps at the first stage and drops at the second",
+        "Player: a large jump in E at the first stage, then a sharp drop",
         "133-135",
-        "in base + framework, E(first) > E(baseline) and E(second) < E(first)",
+        "in base + framework, E(first) > 1.25·E(baseline) and 1.25·E(second) < E(first)",
         _prag_player_jump,
     ),
     Finding(
         "prag-p2p-cost",
         "pragmatics",
-        "P2P: E is high and rises",
+        "P2P: E is high and increases significantly after the second message is added",
         "135",
-        "in base + framework, E(second) > E(first), and P2P's E(second) is the largest",
+        "in base + framework, E(second) > 1.25·E(first), and P2P's E(second) is the largest"
+        " of the approaches",
         _prag_p2p_high_rising,
     ),
     Finding(
         "legacy-soa-cost",
         "legacy",
-        "SOA: E is large at the baseline, then decreases or stabilizes at a near-constant value",
+        "SOA: the initial E is large but decreases or stabilizes at a near constant value",
         "142",
-        "in base + framework, E(first) ≤ 1.25·E(baseline) and E(second) ≤ 1.25·E(first)",
+        "in base + framework, E(baseline) > 0 and no later stage above it; E(second) ≤ E(first)"
+        " or within 1.25x of it",
         _legacy_soa_cost,
     ),
 )

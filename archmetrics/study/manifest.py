@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -10,6 +11,20 @@ from typing import Any
 
 class ManifestError(ValueError):
     """A manifest that cannot be used; the message names the file and the key."""
+
+
+# "as-described": every stage follows a sentence of the thesis about the code it measured;
+# "idiomatic": the same integration written the way the framework is usually written.
+VARIANTS = ("as-described", "idiomatic")
+
+
+@dataclass(frozen=True, slots=True)
+class Follows:
+    """The sentence of the thesis (and its PDF page) that one stage of a subject follows."""
+
+    stage: str
+    sentence: str
+    page: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,6 +40,8 @@ class Manifest:
     locations: tuple[tuple[str, tuple[str, ...]], ...]  # in the manifest's order
     exclude: tuple[str, ...]
     exclude_generated: bool = True  # [exclude] generated = false counts generated files too
+    variant: str = "idiomatic"
+    follows: tuple[Follows, ...] = ()  # one per stage in an as-described manifest
 
     def stage_dir(self, stage: str) -> Path:
         return self.path / stage
@@ -49,6 +66,38 @@ def _text(table: dict[str, Any], key: str, where: str) -> str:
     return value
 
 
+def _variant(table: dict[str, Any], where: str) -> str:
+    variant = _text(table, "variant", where)
+    if variant not in VARIANTS:
+        raise ManifestError(f"{where}: variant must be one of {', '.join(VARIANTS)}")
+    return variant
+
+
+def _follows(
+    table: dict[str, Any], stages: tuple[str, ...], variant: str, where: str
+) -> tuple[Follows, ...]:
+    """[stage.<name>] follows = "<sentence>", page = <n>: required of every as-described stage."""
+    given = table.get("stage", {})
+    if not isinstance(given, dict):
+        raise ManifestError(f"{where}: [stage] must be a table of stages")
+    for name in given:
+        if name not in stages:
+            raise ManifestError(f"{where}: stage.{name}: no such stage in 'stages'")
+    found = []
+    for stage in stages:
+        entry = given.get(stage)
+        if entry is None:
+            if variant == "as-described":
+                raise ManifestError(f"{where}: stage.{stage}: an as-described stage needs follows")
+            continue
+        key = f"{where}: stage.{stage}"
+        page = entry.get("page") if isinstance(entry, dict) else None
+        if not isinstance(page, int) or isinstance(page, bool) or page <= 0:
+            raise ManifestError(f"{key}: 'page' must be a positive whole number")
+        found.append(Follows(stage, _text(entry, "follows", key), page))
+    return tuple(found)
+
+
 def load_manifest(folder: Path) -> Manifest:
     """The manifest in ``folder``; every stage it names must be a folder beside it."""
     file = folder / "manifest.toml"
@@ -65,9 +114,11 @@ def load_manifest(folder: Path) -> Manifest:
     if not isinstance(locations, dict):
         raise ManifestError(f"{where}: [locations] must be a table")
     exclude = table.get("exclude", {})
+    subject = _text(table, "subject", where)
+    variant = _variant(table, where)
     return Manifest(
         path=folder,
-        subject=_text(table, "subject", where),
+        subject=subject,
         approach=_text(table, "approach", where),
         title=_text(table, "title", where),
         thesis_pages=str(table.get("thesis_pages", "")),
@@ -78,10 +129,24 @@ def load_manifest(folder: Path) -> Manifest:
         ),
         exclude=_strings(exclude.get("paths", []), f"{where}: exclude.paths"),
         exclude_generated=_flag(exclude.get("generated", True), f"{where}: exclude.generated"),
+        variant=variant,
+        follows=_follows(table, stages, variant, where),
     )
 
 
 def find_manifests(root: Path) -> tuple[Manifest, ...]:
-    """Every subject/approach manifest under ``root``, sorted by subject then approach."""
-    found = [load_manifest(p.parent) for p in sorted(root.glob("*/*/manifest.toml"))]
-    return tuple(sorted(found, key=lambda m: (m.subject, m.approach)))
+    """Every manifest under ``root`` (``<subject>/<approach>/`` for the idiomatic variant,
+    ``as-described/<subject>/<approach>/`` for the other), sorted by variant, subject and
+    approach. Two manifests for the same variant, subject and approach are an error."""
+    folders = [*root.glob("*/*/manifest.toml"), *root.glob("*/*/*/manifest.toml")]
+    found = sorted(
+        (load_manifest(p.parent) for p in folders),
+        key=lambda m: (m.variant, m.subject, m.approach),
+    )
+    for a, b in itertools.pairwise(found):
+        if (a.variant, a.subject, a.approach) == (b.variant, b.subject, b.approach):
+            raise ManifestError(
+                f"{b.path / 'manifest.toml'}: {b.variant} {b.subject}/{b.approach} is also"
+                f" {a.path / 'manifest.toml'}"
+            )
+    return tuple(found)

@@ -12,6 +12,7 @@ import pytest
 
 from archmetrics.app.replicate import settings_for, subjects_root
 from archmetrics.cli import main
+from archmetrics.study.causes import load_causes
 from archmetrics.study.findings import FINDINGS
 from archmetrics.study.manifest import ManifestError, find_manifests, load_manifest
 
@@ -37,19 +38,21 @@ def report(study: Path) -> Any:
 
 
 def _total(report: Any, subject: str, approach: str, stage: str, location: str) -> Any:
-    stages = report["subjects"][subject]["series"][approach]["stages"]
+    subjects = report["variants"]["idiomatic"]["subjects"]
+    stages = subjects[subject]["series"][approach]["stages"]
     return next(s for s in stages if s["label"] == stage)["locations"][location]
 
 
 def test_every_subject_approach_and_stage_is_measured(report: Any) -> None:
-    assert report["schema"] == "archmetrics.study/1"
-    approaches = {s: sorted(v["series"]) for s, v in report["subjects"].items()}
+    assert report["schema"] == "archmetrics.study/2"
+    subjects = report["variants"]["idiomatic"]["subjects"]
+    approaches = {s: sorted(v["series"]) for s, v in subjects.items()}
     assert approaches == {
         "wdb": ["p2p", "player", "soa"],
         "pragmatics": ["p2p", "player", "soa"],
         "legacy": ["soa"],
     }
-    for subject in report["subjects"].values():
+    for subject in [*subjects.values(), *report["variants"]["as-described"]["subjects"].values()]:
         for series in subject["series"].values():
             assert [s["label"] for s in series["stages"]] == ["baseline", "first", "second"]
             baseline = series["stages"][0]
@@ -59,8 +62,25 @@ def test_every_subject_approach_and_stage_is_measured(report: Any) -> None:
 def test_every_finding_has_a_verdict_from_measured_numbers(report: Any) -> None:
     assert [f["id"] for f in report["findings"]] == [f.id for f in FINDINGS]
     for finding in report["findings"]:
-        assert finding["agrees"] in (True, False)
-        assert any(ch.isdigit() for ch in finding["measured"])
+        assert {"id", "claim", "pages", "rule"} <= set(finding)
+        assert sorted(finding["variants"]) == ["as-described", "idiomatic"]
+        idiomatic = finding["variants"]["idiomatic"]
+        assert idiomatic["agrees"] in (True, False)
+        assert any(ch.isdigit() for ch in idiomatic["measured"])
+        for variant in finding["variants"].values():
+            assert set(variant) == {"agrees", "measured", "cause"}
+
+
+def test_every_disagreement_names_a_recorded_cause_and_none_is_stale(report: Any) -> None:
+    causes = load_causes()
+    for finding in report["findings"]:
+        for name, variant in finding["variants"].items():
+            recorded = (finding["id"], name) in causes
+            if variant["agrees"] is False:
+                assert recorded, f"{finding['id']} ({name}) disagrees with no cause recorded"
+                assert variant["cause"].startswith(causes[finding["id"], name].kind)
+            else:
+                assert not recorded, f"a cause is recorded for {finding['id']} ({name})"
 
 
 def test_measured_shapes(report: Any) -> None:
@@ -79,45 +99,57 @@ def test_measured_shapes(report: Any) -> None:
 
 def test_report_and_charts_are_written(study: Path) -> None:
     markdown = (study / "report.md").read_text()
-    assert "## Findings" in markdown and "## Subject `wdb`" in markdown
-    charts = sorted((study / "charts").iterdir())
+    assert "## Findings" in markdown and "## Subject `wdb`, idiomatic" in markdown
+    charts = sorted((study / "charts" / "idiomatic").iterdir())
     for subject in ("wdb", "pragmatics", "legacy"):
         for kind in ("coupling", "scaled_changes", "scaled_complexity", "cost"):
             for fmt in ("png", "svg"):
-                chart = study / "charts" / f"{subject}-{kind}.{fmt}"
+                chart = study / "charts" / "idiomatic" / f"{subject}-{kind}.{fmt}"
                 assert chart in charts and chart.stat().st_size > 5000
-        assert f"charts/{subject}-cost.png" in markdown
-    assert (study / "charts" / "wdb-cost.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert f"charts/idiomatic/{subject}-cost.png" in markdown
+    png = (study / "charts" / "idiomatic" / "wdb-cost.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_the_repositories_have_a_tag_per_stage(built: tuple[Path, Path]) -> None:
-    repo = built[1] / "wdb" / "soa"
+    repo = built[1] / "idiomatic" / "wdb" / "soa"
     done = subprocess.run(["git", "-C", str(repo), "tag"], capture_output=True, text=True)
     assert sorted(done.stdout.split()) == ["baseline", "first", "second"]
 
 
 def test_manifests_load_and_become_settings() -> None:
     manifests = find_manifests(subjects_root())
-    assert len(manifests) == 7
+    assert sum(m.variant == "idiomatic" for m in manifests) == 7
+    described = sorted((m.subject, m.approach) for m in manifests if m.variant == "as-described")
+    assert described == sorted((m.subject, m.approach) for m in manifests
+                               if m.variant == "idiomatic")  # fmt: skip
+    assert all(len(m.follows) == len(m.stages) for m in manifests if m.variant == "as-described")
     wdb_soa = next(m for m in manifests if (m.subject, m.approach) == ("wdb", "soa"))
     settings = settings_for(wdb_soa)
     assert settings.locations.new == ("wdb/**",) and not settings.include_generated
 
 
+HEAD = 'subject = "s"\napproach = "a"\nvariant = "idiomatic"\ntitle = "t"\n'
+
+
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = ["baseline"]\n', "has no folder"),
+        (f'{HEAD}stages = ["baseline"]\n', "has no folder"),
         ('approach = "a"\ntitle = "t"\nstages = []\n', "'subject' must be a non-empty string"),
-        ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = "x"\n', "stages: expected a list"),
-        (
-            'subject = "s"\napproach = "a"\ntitle = "t"\nstages = []\n[exclude]\ngenerated = 1\n',
-            "exclude.generated: expected true or false",
-        ),
+        (f'{HEAD}stages = "x"\n', "stages: expected a list"),
+        (f"{HEAD}stages = []\n[exclude]\ngenerated = 1\n", "exclude.generated: expected true"),
+        ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = []\n', "'variant' must be a"),
+        (f'{HEAD.replace("idiomatic", "literal")}stages = []\n', "variant must be one of"),
+        (f'{HEAD.replace("idiomatic", "as-described")}stages = ["s"]\n', "stage.s: an as-desc"),
+        (f'{HEAD}stages = ["s"]\n[stage.s]\nfollows = "x"\npage = "9"\n', "stage.s: 'page'"),
+        (f'{HEAD}stages = ["s"]\n[stage.s]\npage = 9\n', "stage.s: 'follows' must be"),
+        (f'{HEAD}stages = []\n[stage.t]\nfollows = "x"\npage = 9\n', "stage.t: no such stage"),
     ],
 )
 def test_bad_manifests_are_named(tmp_path: Path, text: str, message: str) -> None:
     (tmp_path / "manifest.toml").write_text(text)
+    (tmp_path / "s").mkdir()
     with pytest.raises(ManifestError, match=message) as error:
         load_manifest(tmp_path)
     assert "manifest.toml" in str(error.value)
@@ -130,3 +162,35 @@ def test_an_unknown_subject_is_a_one_line_error(capsys: pytest.CaptureFixture[st
         err
         == "archmetrics: error: no study subject 'foo'; the subjects are: legacy, pragmatics, wdb"
     )
+
+
+def test_the_appendix_lists_every_element_and_sums_to_the_locations(
+    study: Path, report: Any
+) -> None:
+    """report.md's appendix (the thesis's appendices C-I): the framework elements of one stage
+    add up to the framework location's change count and v_g in report.json."""
+    markdown = (study / "report.md").read_text()
+    appendix = markdown[markdown.index("## Appendix: every element") :]
+    section = appendix[appendix.index("### `wdb`, idiomatic") :]
+    section = section.split("\n### ")[0]
+    rows = [
+        [cell.strip() for cell in line.strip("|").split("|")]
+        for line in section.splitlines()
+        if line.startswith("| p2p | first |")
+    ]
+    framework = [row for row in rows if row[3] == "framework"]
+    assert [row[2] for row in framework] == ["server/wdb-server"]  # element: the file, no suffix
+    expected = _total(report, "wdb", "p2p", "first", "framework")
+    assert sum(int(row[7]) + int(row[8]) + int(row[9]) for row in framework) == expected["changes"]
+    assert sum(int(row[11]) - int(row[10]) for row in framework) == expected["delta_vg"]
+
+
+def test_the_printed_table_keeps_the_elements_a_cause_names(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Causes name elements in [brackets]; the terminal table prints them (not as markup)."""
+    out = tmp_path / "out"
+    assert main(["replicate", "--subject", "legacy", "--out", str(out), "--no-charts",
+                 "--quiet"]) == 0  # fmt: skip
+    printed = capsys.readouterr().out
+    assert "idiomatic disagrees" in printed and "[p2d_service/*.py," in printed
