@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from archmetrics.app.estimate import EstimateRequest, run_estimate
 from archmetrics.cli.common import UsageError, emit, facts_cache, gate_status, shown_progress
 from archmetrics.cli.measure import check_chart, diff_request, write_chart
 from archmetrics.reports.formats import OutputFormat, render_estimate
@@ -13,6 +12,8 @@ from archmetrics.sources.checkout import open_checkout
 
 
 def estimate_command(args: argparse.Namespace) -> int:
+    from archmetrics.app.estimate import EstimateRequest, run_estimate  # only when asked
+
     check_chart(args)
     fmt = OutputFormat(args.format)
     if not args.actual and (args.head is not None or args.stage is not None):

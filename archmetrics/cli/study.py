@@ -6,13 +6,16 @@ import argparse
 import sys
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from archmetrics.cli.common import EXIT_OK, UsageError, facts_cache, shown_progress
 from archmetrics.config import Settings
 from archmetrics.reports.formats import OutputFormat
-from archmetrics.study.causes import Cause
 from archmetrics.study.findings import FINDINGS
 from archmetrics.study.report import StudyReport, VariantResult
+
+if TYPE_CHECKING:
+    from archmetrics.study.causes import Cause
 
 
 def replicate_command(args: argparse.Namespace) -> int:

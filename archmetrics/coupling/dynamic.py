@@ -57,6 +57,13 @@ def normalize_callee(callee: str) -> str:
     return text.replace("->", ".").replace("::", ".").lstrip(".")
 
 
+@lru_cache(maxsize=65536)
+def _normalized(callee: str) -> tuple[str, str]:
+    """A callee normalized, and the last part of that (callees repeat across files)."""
+    name = normalize_callee(callee)
+    return name, name.rsplit(".", 1)[-1]
+
+
 @lru_cache(maxsize=4096)
 def _compiled(pattern: str) -> re.Pattern[str]:
     return re.compile(translate(normalize_callee(pattern)))
@@ -102,6 +109,21 @@ class RuleIndex:
                     self.wild.append(entry)
                 else:
                     self.by_name.setdefault(last, []).append(entry)
+        wild = "|".join(f"(?:{_compiled(pattern).pattern})" for _, _, pattern in self.wild)
+        self._wild = re.compile(wild) if wild else None
+
+    def may_match(self, callees: Iterable[str]) -> bool:
+        """Whether a rule could match one of ``callees`` (True may be wrong, False never is):
+        a name's last part is one a rule's pattern ends in, or a wildcard pattern matches it.
+        One set look-up a callee, where ``choose`` tries each candidate rule's pattern."""
+        if self._wild is None and not self.by_name:
+            return False
+        by_name, wild = self.by_name, self._wild
+        for callee in callees:
+            name, last = _normalized(callee)
+            if last in by_name or (wild is not None and wild.match(name)):
+                return True
+        return False
 
     def choose(self, callee: str, module_receiver: bool = False) -> Rule | None:
         """The rule a callee matches: highest priority first, then load order.
@@ -238,9 +260,9 @@ class LinkFilter:
                 rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION)),
             )
         calls, definitions = indexes
-        if any(map(calls.choose, facts.callees())):
+        if calls.may_match(facts.callees()):
             return True
-        return any(definitions.choose(f.qualified_name) for f in facts.functions)
+        return definitions.may_match(f.qualified_name for f in facts.functions)
 
 
 def file_link_sites(

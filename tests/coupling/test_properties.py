@@ -5,9 +5,10 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from archmetrics.coupling.dynamic import matches, normalize_callee
+from archmetrics.coupling.dynamic import RuleIndex, matches, normalize_callee, rule_index
 from archmetrics.coupling.endpoints import literal, normalize
-from archmetrics.coupling.rules import ENDPOINT_TYPES
+from archmetrics.coupling.loader import load_rule_packs
+from archmetrics.coupling.rules import ENDPOINT_TYPES, SiteKind
 
 
 @given(st.text(max_size=60))
@@ -28,3 +29,31 @@ def test_normalize_callee_is_idempotent_and_a_callee_matches_itself_as_a_pattern
     assert normalize_callee(once) == once
     if once and not any(c in once for c in "*?[]"):
         assert matches(once, text)
+
+
+def _indexes() -> list[RuleIndex]:
+    rules = load_rule_packs([]).rules
+    return [
+        rule_index(tuple(r for r in rules if r.site is site and language in r.languages))
+        for language in ("c", "cpp", "python")
+        for site in (SiteKind.CALL, SiteKind.DEFINITION)
+    ]
+
+
+_NAMES = sorted({p.replace("*", "x") for r in load_rule_packs([]).rules for p in r.match})
+
+
+@given(
+    st.one_of(
+        st.sampled_from(_NAMES),
+        st.builds(lambda a, b: f"{a}.{b}", st.text(max_size=8), st.sampled_from(_NAMES)),
+        st.builds(lambda a, b: f"{a}->{b}", st.text(max_size=8), st.sampled_from(_NAMES)),
+        st.text(max_size=30),
+    )
+)
+def test_a_callee_a_rule_matches_is_never_filtered_out(callee: str) -> None:
+    """The link filter's answer (may_match) is a superset of what choose finds: a file it
+    says no to has no link site."""
+    for index in _indexes():
+        if index.choose(callee) is not None or index.choose(callee, True) is not None:
+            assert index.may_match([callee])
