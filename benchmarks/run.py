@@ -187,8 +187,9 @@ def edit_rows(bench: Bench, history: Path, tag: str) -> list[report.Result]:
 
 
 def copies_repository(bench: Bench, tree: Path, copies: int) -> Path:
-    """A repository whose one commit holds ``copies`` copies of ``tree``, under c0, c1 ...
-    (hard links where possible): the same code base, ``copies`` times the files. Reused."""
+    """A repository whose one commit holds ``copies`` copies of ``tree``, under c0, c1 ...:
+    the same code base, ``copies`` times the files. Reused. Real copies, not hard links: the
+    edits the benchmark appends must not reach the unpacked release or the other copies."""
     repo = bench.work / f"copies-{copies}"
     if (repo / ".git").exists() and corpus.git(repo, "tag", "--list").split() == ["built"]:
         corpus.git(repo, "checkout", "-q", "--", ".")  # an earlier run's edits undone
@@ -197,7 +198,7 @@ def copies_repository(bench: Bench, tree: Path, copies: int) -> Path:
         shutil.rmtree(repo)
     repo.mkdir(parents=True)
     for index in range(copies):
-        shutil.copytree(tree, repo / f"c{index}", symlinks=True, copy_function=os.link)
+        shutil.copytree(tree, repo / f"c{index}", symlinks=True)
     corpus.git(repo, "init", "-q")
     corpus.git(repo, "add", "--all", "--force", ".")
     corpus.git(repo, "commit", "-q", "--no-verify", "-m", f"{copies} copies")
