@@ -260,6 +260,10 @@ class Composite:
 
 
 def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
+    if "\r" in source:  # a compiler reads \r\n and a lone \r as newlines, and so do we: the
+        # macro rules read lines as ending in \n (a CRLF checkout of a file read otherwise
+        # than its LF blob; docs/metrics.md, "Line endings")
+        source = source.replace("\r\n", "\n").replace("\r", "\n")
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
     first = blank_macros(data, names=limits.c_macros, first=True)
