@@ -55,6 +55,9 @@ def test_wheel_contents(wheel: Path) -> None:
         "archmetrics/schemas/compare-1.schema.json",
         "archmetrics/schemas/plan-1.schema.json",
         "archmetrics/schemas/estimate-1.schema.json",
+        "archmetrics/schemas/graph-1.schema.json",
+        "archmetrics/schemas/rules-1.schema.json",
+        "archmetrics/schemas/study-2.schema.json",
     ):
         assert required in names, required
     assert not [n for n in names if "__pycache__" in n or n.endswith((".pyc", ".o", ".so"))]
