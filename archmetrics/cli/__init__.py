@@ -16,7 +16,6 @@ from contextlib import contextmanager
 
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
-from archmetrics.changeset.locations import BadPattern
 from archmetrics.changeset.plan import PlanError
 from archmetrics.cli import estimate, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
@@ -24,6 +23,7 @@ from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
+from archmetrics.globs import BadPattern
 from archmetrics.parsers import UnknownLanguage
 from archmetrics.reports.printable import one_line
 from archmetrics.sources import SourceError

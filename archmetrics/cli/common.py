@@ -14,9 +14,9 @@ from archmetrics.app import settings as app_settings
 from archmetrics.app.collect import open_cache
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.changeset.locations import BadPattern
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import Settings
+from archmetrics.globs import BadPattern
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.model import EstimateFailure
 from archmetrics.reports.printable import one_line, shown_lines
