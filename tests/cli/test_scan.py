@@ -203,6 +203,22 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
     assert document["totals"]["warnings"] == 0  # type: ignore[index]
     assert main(["scan", str(repo.root), "-q"]) == 0
     assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
+    # every report lists it: Markdown, and the CSV as a row of its own, its reason last
+    assert main(["scan", str(repo.root), "-q", "--format", "markdown"]) == 0
+    assert "- excluded `vendor/v.py`: exclude:vendor/**" in capsys.readouterr().out
+    assert main(["scan", str(repo.root), "-q", "--format", "csv"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith(",excluded") and lines[-1] == "vendor/v.py,,,,,,,exclude:vendor/**"
+    repo.commit("v2", files={"vendor/v.py": "x = 2\n", "src/p.py": PY_V2 + "z = 1\n"})
+    for fmt, listed in (("markdown", "- excluded `vendor/v.py`: exclude:vendor/**"),
+                        ("table", "excluded vendor/v.py: exclude:vendor/**"),
+                        ("csv", "excluded,vendor/v.py,")):  # fmt: skip
+        argv = ["diff", "-C", str(repo.root), "--base", "HEAD~1", "--head", "HEAD", "-q"]
+        assert main([*argv, "--format", fmt]) == 0
+        out = capsys.readouterr().out
+        assert listed in out, fmt
+        # its old side does not parse, but it is excluded: listed for that, no warning shown
+        assert "not_parsed" not in out and "syntax error" not in out, fmt
 
 
 def test_exclude_on_the_command_line_adds_to_the_configured_globs(
