@@ -6,6 +6,7 @@ import json
 import sqlite3
 import subprocess
 import sys
+import venv
 from pathlib import Path
 
 import pytest
@@ -248,12 +249,15 @@ def test_a_plain_folder_scan_lists_the_folders_it_skipped(
 ) -> None:
     (tmp_path / "venv").mkdir()
     (tmp_path / "venv" / "__init__.py").write_text(PY_V2)  # a package named venv
-    (tmp_path / "env" / "lib").mkdir(parents=True)
-    (tmp_path / "env" / "pyvenv.cfg").write_text("home = /usr/bin\n")
-    (tmp_path / "env" / "lib" / "site.py").write_text(PY_V2)
+    # a real virtual environment, as python -m venv makes it (its site-packages get a module)
+    venv.EnvBuilder(with_pip=False, symlinks=True).create(tmp_path / "env")
+    [site] = (tmp_path / "env").glob("lib/python*/site-packages")
+    (site / "installed.py").write_text(PY_V2)
     document = _json(capsys, "scan", str(tmp_path), "--format", "json", "-q", "--no-cache")
     assert list(_files(document)) == ["venv/__init__.py"]
     assert document["excluded"] == [{"path": "env/", "reason": "virtual environment (pyvenv.cfg)"}]
+    assert main(["scan", str(tmp_path), "-q", "--no-cache"]) == 0
+    assert "excluded env/: virtual environment (pyvenv.cfg)" in capsys.readouterr().out
 
 
 def test_verbose_adds_cache_and_time_detail_and_quiet_stays_quiet(
