@@ -32,7 +32,8 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
         "--output",
         "-o",
         type=Path,
-        help="write the report to FILE (.json, .md or .csv picks the format unless --format)",
+        help="write the report to FILE (.json, .md, .csv or .sarif picks the format unless"
+        " --format)",
     )
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
