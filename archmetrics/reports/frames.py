@@ -61,6 +61,12 @@ def scan_table(report: ScanReport, grouping: str = "file", excluded: bool = Fals
         columns = ("element", "where", "link", "rule", "kind", "role", "target", "status")
         rows = coupling_rows.link_rows(report.coupling)  # "" where a static link has no kind
         return Table(columns, [tuple(cell or None for cell in row) for row in rows])
+    return _file_table(report, excluded)
+
+
+def _file_table(report: ScanReport, excluded: bool) -> Table:
+    """A row per file; with ``excluded``, a row per excluded file too (no numbers: listed,
+    not counted) and the reason in a last column."""
     columns = ("path", "language", "loc", "sloc", "vg", "functions", "warnings")
     rows: list[tuple[Cell, ...]] = [
         (f.path, f.language, f.loc, f.sloc, f.vg, len(f.functions), len(f.warnings))
@@ -68,8 +74,9 @@ def scan_table(report: ScanReport, grouping: str = "file", excluded: bool = Fals
     ]
     if not excluded:
         return Table(columns, rows)
-    listed = [(x.path, *(None,) * 6, x.reason) for x in report.excluded]  # listed, not counted
-    return Table((*columns, "excluded"), [(*row, None) for row in rows] + listed)
+    rows = [(*row, None) for row in rows]
+    rows += [(x.path, *(None,) * 6, x.reason) for x in report.excluded]
+    return Table((*columns, "excluded"), rows)
 
 
 def diff_table(report: DiffReport) -> Table:
