@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from archmetrics.changeset.locations import BadPattern, compile_glob
+from archmetrics.globs import BadPattern, compile_glob
 
 CONFIG_FILES = ("archmetrics.toml", "pyproject.toml")
 

@@ -48,9 +48,15 @@ def _same(frame: pd.DataFrame, csv: pd.DataFrame) -> None:
 def test_a_scan_frame_has_the_rows_and_columns_of_the_csv(
     stages: GitRepo, capsys: pytest.CaptureFixture[str], by: str
 ) -> None:
-    frame = api.scan(stages.root, by=by, cache=False)
+    frame = api.scan(stages.root, by=by, cache=False, exclude=["*.h"])
     assert len(frame) > 0
-    _same(frame, _csv(capsys, "scan", str(stages.root), "--by", by))
+    csv = _csv(capsys, "scan", str(stages.root), "--by", by, "--exclude", "*.h")
+    if by == "file":  # the CSV also lists each excluded file, with its reason, last
+        listed = csv[csv["excluded"].notna()]
+        assert listed[["path", "excluded"]].values.tolist() == [["new/m.h", "exclude:*.h"]]
+        assert listed.drop(columns=["path", "excluded"]).isna().all().all()
+        csv = csv[csv["excluded"].isna()].drop(columns="excluded")
+    _same(frame, csv)
 
 
 def test_a_scan_frame_holds_numbers_as_numbers(stages: GitRepo) -> None:

@@ -291,11 +291,16 @@ def change_key(
     return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
-def parse_warnings(*sides: Sequence[FileFacts]) -> tuple[ParseWarning, ...]:
-    """Every distinct parse warning of the files of each side, in order."""
+def parse_warnings(
+    *sides: Sequence[FileFacts], rules: LocationRules | None = None
+) -> tuple[ParseWarning, ...]:
+    """Every distinct parse warning of the files of each side, in order; none of a file an
+    exclude glob of ``rules`` leaves out (it is listed as excluded, as a scan lists it)."""
     seen: dict[str, ParseWarning] = {}
     for side in sides:
         for facts in side:
+            if rules is not None and rules.is_excluded(facts.path):
+                continue
             for w in facts.warnings:
                 seen.setdefault(str(w), w)
     return tuple(seen.values())
@@ -369,7 +374,7 @@ def measure_snapshots(
         diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
     )
     progress.stop()
-    return change, parse_warnings(pre, post)
+    return change, parse_warnings(pre, post, rules=rules)
 
 
 def run_diff(

@@ -7,8 +7,8 @@ import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
-from archmetrics.changeset.locations import compile_glob
 from archmetrics.config import Settings, load_settings
+from archmetrics.globs import compile_glob
 
 
 def repo_root(path: Path) -> Path:
@@ -20,7 +20,7 @@ def repo_root(path: Path) -> Path:
 
 def settings_for(path: Path, exclude: Sequence[str] = ()) -> Settings:
     """The settings of the repository or folder holding ``path``, with ``exclude`` after the
-    configured globs (each checked now: :class:`~archmetrics.changeset.locations.BadPattern`
+    configured globs (each checked now: :class:`~archmetrics.globs.BadPattern`
     names a bad one)."""
     return settings_at(repo_root(path), exclude)
 

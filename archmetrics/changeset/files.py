@@ -49,13 +49,11 @@ def _measured_pair(
 ) -> tuple[FilePair | None, list[ExcludedFile]]:
     """The measured part of a pair and what was left out of it.
 
-    A side that could not be parsed drops the whole pair (diffing it would show every
-    statement as added or removed). An excluded side alone drops only that side: a file that
-    leaves ``generated/`` for hand-written code is an addition.
+    An excluded side alone drops only that side: a file that leaves ``generated/`` for
+    hand-written code is an addition. A side left that could not be parsed drops the whole
+    pair (diffing it would show every statement as added or removed); an excluded side is
+    listed for its exclusion, whether it could be parsed or not (as ``scan`` lists it).
     """
-    sides = [f for f in (pair.pre, pair.post) if f is not None]
-    if any(not f.parsed for f in sides):
-        return None, [ExcludedFile(pair.path, "not_parsed")]
     reasons = tuple(None if f is None else exclusion(f, rules) for f in (pair.pre, pair.post))
     excluded = {
         ExcludedFile(f.path, r)
@@ -64,8 +62,11 @@ def _measured_pair(
     }
     pre = None if reasons[0] else pair.pre
     post = None if reasons[1] else pair.post
+    listed = sorted(excluded, key=lambda x: (x.path, x.reason))
+    if any(f is not None and not f.parsed for f in (pre, post)):
+        return None, [ExcludedFile(pair.path, "not_parsed"), *listed]
     kept = FilePair(pre, post) if pre or post else None
-    return kept, sorted(excluded, key=lambda x: (x.path, x.reason))
+    return kept, listed
 
 
 def measured_pairs(

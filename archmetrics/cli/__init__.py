@@ -16,14 +16,14 @@ from contextlib import contextmanager
 
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
-from archmetrics.changeset.locations import BadPattern
 from archmetrics.changeset.plan import PlanError
-from archmetrics.cli import estimate, measure, study
+from archmetrics.cli import docs, estimate, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
+from archmetrics.globs import BadPattern
 from archmetrics.parsers import UnknownLanguage
 from archmetrics.reports.printable import one_line
 from archmetrics.sources import SourceError
@@ -41,6 +41,7 @@ COMMANDS = {
     "rules": measure.rules_command,
     "graph": measure.graph_command,
     "cache": measure.cache_command,
+    "docs": docs.docs_command,
 }
 CANNOT_MEASURE = (
     SourceError,

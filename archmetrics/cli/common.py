@@ -14,9 +14,9 @@ from archmetrics.app import settings as app_settings
 from archmetrics.app.collect import open_cache
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.changeset.locations import BadPattern
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.config import Settings
+from archmetrics.globs import BadPattern
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.reports.model import EstimateFailure
 from archmetrics.reports.printable import one_line, shown_lines
@@ -30,7 +30,24 @@ class UsageError(Exception):
     """Bad usage found after parsing (a missing file, a bad value)."""
 
 
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's, except that a path in the text (the installed docs, in site-packages) is
+    never broken at a hyphen or inside itself."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        import textwrap
+
+        return textwrap.fill(
+            " ".join(text.split()), width, initial_indent=indent, subsequent_indent=indent,
+            break_on_hyphens=False, break_long_words=False,
+        )  # fmt: skip
+
+
 class Parser(argparse.ArgumentParser):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
 

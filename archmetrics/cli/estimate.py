@@ -8,6 +8,7 @@ from pathlib import Path
 from archmetrics.cli.common import UsageError, emit, facts_cache, gate_status, shown_progress
 from archmetrics.cli.measure import check_chart, diff_request, write_chart
 from archmetrics.reports.formats import OutputFormat, render_estimate
+from archmetrics.reports.model import CompareReport
 from archmetrics.sources.checkout import open_checkout
 
 
@@ -33,5 +34,7 @@ def estimate_command(args: argparse.Namespace) -> int:
         p.phase("writing the report")
         text = render_estimate(report, fmt)
     emit(text, args.output)
-    write_chart(args, report.compare())
+    # the chart says it is an estimate, as every report does: each series is named so
+    estimated = tuple((f"{name} (estimate)", series) for name, series in report.compare().series)
+    write_chart(args, CompareReport(estimated))
     return gate_status(report.failures, args)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from archmetrics import __version__
 from archmetrics.cli.common import Parser
+from archmetrics.cli.docs import docs_root
 from archmetrics.reports.charts import chart_kinds
 from archmetrics.reports.formats import Grouping, OutputFormat
 
@@ -31,7 +32,8 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
         "--output",
         "-o",
         type=Path,
-        help="write the report to FILE (.json, .md or .csv picks the format unless --format)",
+        help="write the report to FILE (.json, .md, .csv or .sarif picks the format unless"
+        " --format)",
     )
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
@@ -107,6 +109,16 @@ def add_locations(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def docs_epilog() -> str:
+    """Where the installed pages are, for --help (they ship inside the wheel)."""
+    root = docs_root()
+    where = f"installed in {root}" if root is not None else "missing from this installation"
+    return (
+        f"Docs: {where}: metrics.md (what is counted), json.md (the JSON contract), ci.md"
+        " (CI, pre-commit, code scanning); `archmetrics docs [TOPIC]` lists them or prints one."
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
         prog="archmetrics",
@@ -114,7 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
         "coupling, logical LOC, McCabe complexity and the complexity change cost E "
         "(Hestand 2011), per location (base, new, framework).",
         epilog="Exit status: 0 measured (all gates hold), 1 a gate failed, 2 could not measure. "
-        "Docs: docs/metrics.md (what is counted), docs/json.md (the JSON contract).",
+        + docs_epilog(),
     )
     parser.add_argument("--version", action="version", version=f"archmetrics {__version__}")
     parser.add_argument(
@@ -250,6 +262,11 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
     add_exclude(graph)
+    docs = commands.add_parser(
+        "docs", help="the documentation installed with archmetrics: list the pages, print one"
+    )
+    docs.add_argument("topic", nargs="?", metavar="TOPIC", help="a page, e.g. ci, json, metrics")
+    docs.add_argument("--path", action="store_true", help="print the page's file, not its text")
     cache = commands.add_parser("cache", help="the facts cache: where it is, how big; clear it")
     cache.add_argument("action", choices=["info", "clear"])
     cache.add_argument("--cache-path", type=Path, help="the facts cache file")

@@ -12,8 +12,8 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
-from fnmatch import translate
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
@@ -29,6 +29,10 @@ from archmetrics.coupling.rules import (
 )
 from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader
 from archmetrics.facts import Argument, CallSite, FileFacts
+from archmetrics.globs import compile_glob, compile_globs
+
+if TYPE_CHECKING:
+    from pathspec import GitIgnoreSpec
 
 
 class AmbiguousEndpoint(Exception):
@@ -65,13 +69,15 @@ def _normalized(callee: str) -> tuple[str, str]:
 
 
 @lru_cache(maxsize=4096)
-def _compiled(pattern: str) -> re.Pattern[str]:
-    return re.compile(translate(normalize_callee(pattern)))
+def _compiled(pattern: str) -> GitIgnoreSpec:
+    """A rule's ``match`` glob, in the one glob dialect (archmetrics.globs): a callee name
+    has no ``/``, so ``*`` takes any run of it, dots included."""
+    return compile_glob(normalize_callee(pattern))
 
 
 def matches(pattern: str, callee: str) -> bool:
     """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches."""
-    return _compiled(pattern).match(normalize_callee(callee)) is not None
+    return _compiled(pattern).match_file(normalize_callee(callee))
 
 
 def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
@@ -109,8 +115,8 @@ class RuleIndex:
                     self.wild.append(entry)
                 else:
                     self.by_name.setdefault(last, []).append(entry)
-        wild = "|".join(f"(?:{_compiled(pattern).pattern})" for _, _, pattern in self.wild)
-        self._wild = re.compile(wild) if wild else None
+        wild = tuple(normalize_callee(pattern) for _, _, pattern in self.wild)
+        self._wild = compile_globs(wild) if wild else None
 
     def may_match(self, callees: Iterable[str]) -> bool:
         """Whether a rule could match one of ``callees`` (True may be wrong, False never is):
@@ -121,7 +127,7 @@ class RuleIndex:
         by_name, wild = self.by_name, self._wild
         for callee in callees:
             name, last = _normalized(callee)
-            if last in by_name or (wild is not None and wild.match(name)):
+            if last in by_name or (wild is not None and wild.match_file(name)):
                 return True
         return False
 
@@ -142,7 +148,7 @@ class RuleIndex:
             if module_receiver and pattern.startswith("*"):
                 continue
             rank = (rule.priority, -order)
-            if (best is None or rank > best[:2]) and _compiled(pattern).match(name):
+            if (best is None or rank > best[:2]) and _compiled(pattern).match_file(name):
                 best = (*rank, rule)
         return best[2] if best else None
 

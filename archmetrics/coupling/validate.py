@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NoReturn
 
+from archmetrics.coupling.dynamic import normalize_callee
 from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
@@ -21,6 +22,7 @@ from archmetrics.coupling.rules import (
     RulePackError,
     SiteKind,
 )
+from archmetrics.globs import BadPattern, compile_glob
 
 _PACK_KEYS = frozenset({"name", "description"})
 _RULE_KEYS = frozenset(
@@ -156,9 +158,18 @@ def _examples(
 def _patterns(where: _Where, table: Mapping[str, object]) -> tuple[str, ...]:
     patterns = where.texts(table, "match", required=True)
     for pattern in patterns:
-        if any(c.isspace() for c in pattern) or "(" in pattern:
-            where.fail("match", f"{pattern!r}: a pattern is a dotted callee name with * globs")
+        _check_glob(where, "match", pattern)
     return patterns
+
+
+def _check_glob(where: _Where, key: str, pattern: str) -> None:
+    """A ``match`` pattern: a dotted callee name with globs of the one dialect (globs.py)."""
+    if any(c.isspace() for c in pattern) or "(" in pattern or "/" in pattern:
+        where.fail(key, f"{pattern!r}: a pattern is a dotted callee name with * globs")
+    try:
+        compile_glob(normalize_callee(pattern))
+    except BadPattern as error:
+        where.fail(key, str(error))
 
 
 def _parse_endpoint(where: _Where, raw: object) -> EndpointSpec:
@@ -211,4 +222,5 @@ def _parse_hint(where: _Where, raw: object) -> FunctionHint:
         raise RulePackError(error.source, error.rule, key, error.problem) from None
     if arg is None and keyword is None:
         where.fail("endpoint.same_function", "a hint needs arg or keyword")
+    _check_glob(where, "endpoint.same_function.match", match)
     return FunctionHint(match, arg, keyword)

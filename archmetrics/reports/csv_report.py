@@ -32,8 +32,9 @@ def _csv(table: Table) -> str:
 
 
 def render_scan(report: ScanReport, grouping: str) -> str:
-    """One row per file, function, element or link (``grouping``)."""
-    return _csv(scan_table(report, grouping))
+    """One row per file, function, element or link (``grouping``); by file, the excluded
+    files too (each with its reason in the last column)."""
+    return _csv(scan_table(report, grouping, excluded=True))
 
 
 def render_diff(report: DiffReport) -> str:

@@ -35,8 +35,11 @@ _METRICS = ("loc", "sloc", "vg", "s_a", "s_e", "d_a", "d_e")
 _NUMERIC_SUMMARY = tuple(f for f in SUMMARY_FIELDS if f != "notes")
 
 
-def scan_table(report: ScanReport, grouping: str = "file") -> Table:
-    """One row per file, function, element or link (``grouping``)."""
+def scan_table(report: ScanReport, grouping: str = "file", excluded: bool = False) -> Table:
+    """One row per file, function, element or link (``grouping``); by file with ``excluded``
+    (the CSV), each file the configuration or ``--exclude`` left out too, with its reason
+    in an ``excluded`` column (a DataFrame keeps the measured files alone: numbers stay
+    numbers; ``ScanReport.excluded`` has the rest)."""
     if grouping == "function":
         return Table(
             ("path", "language", "function", "line", "loc", "vg"),
@@ -58,18 +61,28 @@ def scan_table(report: ScanReport, grouping: str = "file") -> Table:
         columns = ("element", "where", "link", "rule", "kind", "role", "target", "status")
         rows = coupling_rows.link_rows(report.coupling)  # "" where a static link has no kind
         return Table(columns, [tuple(cell or None for cell in row) for row in rows])
-    return Table(
-        ("path", "language", "loc", "sloc", "vg", "functions", "warnings"),
-        [
-            (f.path, f.language, f.loc, f.sloc, f.vg, len(f.functions), len(f.warnings))
-            for f in report.files
-        ],
-    )
+    return _file_table(report, excluded)
+
+
+def _file_table(report: ScanReport, excluded: bool) -> Table:
+    """A row per file; with ``excluded``, a row per excluded file too (no numbers: listed,
+    not counted) and the reason in a last column."""
+    columns = ("path", "language", "loc", "sloc", "vg", "functions", "warnings")
+    rows: list[tuple[Cell, ...]] = [
+        (f.path, f.language, f.loc, f.sloc, f.vg, len(f.functions), len(f.warnings))
+        for f in report.files
+    ]
+    if not excluded:
+        return Table(columns, rows)
+    rows = [(*row, None) for row in rows]
+    rows += [(x.path, *(None,) * 6, x.reason) for x in report.excluded]
+    return Table((*columns, "excluded"), rows)
 
 
 def diff_table(report: DiffReport) -> Table:
     """A row per location and the total (``row`` = location: the summary fields), then a row
-    per element (``row`` = element: its Γ counts, its metrics before and after)."""
+    per element (``row`` = element: its Γ counts, its metrics before and after), then a row
+    per excluded file (``row`` = excluded: its path, and its reason as the note)."""
     sides = tuple(f"{side}_{m}" for side in ("pre", "post") for m in _METRICS)
     columns = ("row", "name", "location", "status", *_NUMERIC_SUMMARY, *sides, "files", "notes")
     no_sides: tuple[Cell, ...] = (None,) * len(sides)
@@ -91,6 +104,9 @@ def diff_table(report: DiffReport) -> Table:
             ("element", e.element, e.location.value, e.status.value, *values, *metrics,
              " ".join(e.files), None)
         )  # fmt: skip
+    none = (None,) * (len(_NUMERIC_SUMMARY) + len(sides))
+    for x in report.change.excluded:  # counted nowhere, listed: the reason is its note
+        rows.append(("excluded", x.path, None, None, *none, x.path, x.reason))
     return Table(columns, rows)
 
 

@@ -17,6 +17,7 @@ import pytest
 
 from archmetrics.cli import main
 from tests.gitrepo import GitRepo
+from tests.reports.test_charts import svg_texts
 
 SERVER = """\
 import socket
@@ -248,6 +249,10 @@ def test_a_gate_fails_on_the_architecture_that_exceeds_it(
     codeclimate, _ = run(sketched, capsys, str(plan), "--base", "base", "--fail-on", "changes > 5",
                          "--format", "codeclimate", status=1)  # fmt: skip
     assert [i["description"].split(":")[0] for i in json.loads(codeclimate)] == ["planned estimate"]
+    sarif, _ = run(sketched, capsys, str(plan), "--base", "base", "--fail-on", "changes > 5",
+                   "--format", "sarif", status=1)  # fmt: skip
+    [result] = json.loads(sarif)["runs"][0]["results"]
+    assert result["ruleId"] == "changes > 5" and result["message"]["text"].startswith("planned")
 
 
 BAD_PLANS = [
@@ -459,6 +464,11 @@ def test_a_staged_plan_gives_the_series_each_stage_on_the_one_before(
     assert numbers(drawn[1]["locations"]) == numbers(measured(sketched, capsys)["locations"])
     ranks = {(r["stage"], r["architecture"]) for r in document["ranking"]}
     assert ranks == {(s, a) for s in ("first", "second") for a in ("planned", "drawn")}
+    # the series chart the study draws: one series per architecture over the plan's stages
+    chart = tmp_path / "stages.svg"
+    run(sketched, capsys, str(plan), "--base", "base", "--chart", str(chart), "-q")
+    texts = svg_texts(chart.read_bytes())
+    assert {"first", "second", "planned (estimate)", "drawn (estimate)"} <= set(texts), texts
     mixed = write_plan(
         tmp_path,
         """\

@@ -6,6 +6,7 @@ import json
 import sqlite3
 import subprocess
 import sys
+import venv
 from pathlib import Path
 
 import pytest
@@ -203,6 +204,22 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
     assert document["totals"]["warnings"] == 0  # type: ignore[index]
     assert main(["scan", str(repo.root), "-q"]) == 0
     assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
+    # every report lists it: Markdown, and the CSV as a row of its own, its reason last
+    assert main(["scan", str(repo.root), "-q", "--format", "markdown"]) == 0
+    assert "- excluded `vendor/v.py`: exclude:vendor/**" in capsys.readouterr().out
+    assert main(["scan", str(repo.root), "-q", "--format", "csv"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith(",excluded") and lines[-1] == "vendor/v.py,,,,,,,exclude:vendor/**"
+    repo.commit("v2", files={"vendor/v.py": "x = 2\n", "src/p.py": PY_V2 + "z = 1\n"})
+    for fmt, listed in (("markdown", "- excluded `vendor/v.py`: exclude:vendor/**"),
+                        ("table", "excluded vendor/v.py: exclude:vendor/**"),
+                        ("csv", "excluded,vendor/v.py,")):  # fmt: skip
+        argv = ["diff", "-C", str(repo.root), "--base", "HEAD~1", "--head", "HEAD", "-q"]
+        assert main([*argv, "--format", fmt]) == 0
+        out = capsys.readouterr().out
+        assert listed in out, fmt
+        # its old side does not parse, but it is excluded: listed for that, no warning shown
+        assert "not_parsed" not in out and "syntax error" not in out, fmt
 
 
 def test_exclude_on_the_command_line_adds_to_the_configured_globs(
@@ -232,12 +249,15 @@ def test_a_plain_folder_scan_lists_the_folders_it_skipped(
 ) -> None:
     (tmp_path / "venv").mkdir()
     (tmp_path / "venv" / "__init__.py").write_text(PY_V2)  # a package named venv
-    (tmp_path / "env" / "lib").mkdir(parents=True)
-    (tmp_path / "env" / "pyvenv.cfg").write_text("home = /usr/bin\n")
-    (tmp_path / "env" / "lib" / "site.py").write_text(PY_V2)
+    # a real virtual environment, as python -m venv makes it (its site-packages get a module)
+    venv.EnvBuilder(with_pip=False, symlinks=True).create(tmp_path / "env")
+    [site] = (tmp_path / "env").glob("lib/python*/site-packages")
+    (site / "installed.py").write_text(PY_V2)
     document = _json(capsys, "scan", str(tmp_path), "--format", "json", "-q", "--no-cache")
     assert list(_files(document)) == ["venv/__init__.py"]
     assert document["excluded"] == [{"path": "env/", "reason": "virtual environment (pyvenv.cfg)"}]
+    assert main(["scan", str(tmp_path), "-q", "--no-cache"]) == 0
+    assert "excluded env/: virtual environment (pyvenv.cfg)" in capsys.readouterr().out
 
 
 def test_verbose_adds_cache_and_time_detail_and_quiet_stays_quiet(

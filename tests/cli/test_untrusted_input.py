@@ -24,6 +24,8 @@ SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
         ("[tool.archmetrics]\njobs = -1\n", "non-negative integer"),
         ("[tool.archmetrics]\nexclude = ['[z-a]']\n", "unusable glob '[z-a]'"),
         ("[tool.archmetrics.locations]\nnew = ['src/[b-a].c']\n", "unusable glob"),
+        ("[tool.archmetrics]\nexclude = ['#vendor']\n", "exclude: unusable glob '#vendor'"),
+        ("[tool.archmetrics.locations]\nbase = ['" + "*" * 1025 + "']\n", "longer than 1024"),
         ('[tool.archmetrics]\nlanguages = { ".py" = "cobol" }\n', "no parser for language"),
         ("[tool.archmetrics]\ncache-path = '/'\n", "outside archmetrics's cache directory"),
         (b"\xff\xfe[tool]", "not valid TOML"),

@@ -109,6 +109,17 @@ def test_a_user_pack_loads_after_the_builtin_ones(tmp_path: Path) -> None:
             "priority",
             "integer",
         ),
+        # match globs are the one glob dialect (archmetrics.globs): what it cannot use
+        (GOOD_RULE.replace('"*.ping"', '"!x.ping"'), "ping", "match", "negation"),
+        (GOOD_RULE.replace('"*.ping"', '"#ping"'), "ping", "match", "comment"),
+        (GOOD_RULE.replace('"*.ping"', '"*.[z-a]ing"'), "ping", "match", "unusable glob"),
+        (GOOD_RULE.replace('"*.ping"', '"net/ping"'), "ping", "match", "dotted callee"),
+        (
+            GOOD_RULE.replace("arg = 0", 'same_function = [{ match = "[x", arg = 1 }]'),
+            "ping",
+            "endpoint.same_function.match",
+            "unusable glob",
+        ),
         (GOOD_RULE + GOOD_RULE, "ping", "id", "duplicate"),
         (GOOD_RULE.replace('id = "ping"\n', ""), "#1", "id", "required"),
     ],

@@ -4,6 +4,7 @@ commands write, and refuse documents that break the contract (docs/json.md)."""
 from __future__ import annotations
 
 import json
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -109,9 +110,10 @@ def test_every_series_and_compare_document_holds_to_its_schema(
 
 
 def test_a_stage_is_a_diff_document_in_every_schema() -> None:
-    """series/1 and compare/1 carry diff/1's definitions, copied: they must not drift."""
+    """series/1, compare/1 and study/2 carry diff/1's definitions, copied: they must not
+    drift."""
     diff = _schema("diff-1.schema.json")
-    for name in ("series-1.schema.json", "compare-1.schema.json"):
+    for name in ("series-1.schema.json", "compare-1.schema.json", "study-2.schema.json"):
         copied = _schema(name)["$defs"]
         assert {k: copied[k] for k in diff["$defs"]} == diff["$defs"], name
         stage = copied["stage"]["properties"]
@@ -144,12 +146,63 @@ def test_a_document_that_breaks_the_contract_is_refused(
     assert not _validator(name).is_valid(document)
 
 
-def test_the_schemas_are_where_the_docs_say() -> None:
-    docs = (Path(__file__).resolve().parents[2] / "docs" / "json.md").read_text()
-    for name in (
-        "scan-1.schema.json",
-        "diff-1.schema.json",
-        "series-1.schema.json",
-        "compare-1.schema.json",
+def test_every_graph_document_holds_to_its_schema(
+    history: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["graph", str(history.root), "--format", "json", "--no-cache"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    kinds = {e["kind"] for e in document["edges"]}
+    assert kinds == {"static", "dynamic"}  # client imports shared and connects to server
+    validator = _validator("graph-1.schema.json")
+    validator.validate(document)
+    for break_it in (
+        lambda d: d["edges"][0].update(kind="sideways"),
+        lambda d: d["edges"][0].update(weight=0),
+        lambda d: d["nodes"][0].pop("files"),
     ):
-        assert f"archmetrics/schemas/{name}" in docs
+        broken = json.loads(json.dumps(document))
+        break_it(broken)
+        assert not validator.is_valid(broken)
+
+
+def test_every_rules_document_holds_to_its_schema(
+    repo: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The shipped rules, and a repository's own pack with a rule that requires a module."""
+    pack = (
+        '[pack]\nname = "our-bus"\n[[rules]]\nid = "bus-send"\nlanguage = ["python"]\n'
+        'match = ["*.bus_send"]\nkind = "messaging"\nrole = "initiate"\n'
+        'requires = ["ourbus"]\nendpoint = { type = "topic", arg = 0 }\n'
+    )
+    repo.commit("pack", files={
+        "tools/bus.toml": pack,
+        "archmetrics.toml": '[coupling]\nrule-packs = ["tools/bus.toml"]\n',
+    })  # fmt: skip
+    validator = _validator("rules-1.schema.json")
+    assert main(["rules", "--format", "json", "-C", str(repo.root)]) == 0
+    document = json.loads(capsys.readouterr().out)
+    ours = [r for r in document["rules"] if r["rule"] == "bus-send"]
+    assert ours and ours[0]["requires"] == "ourbus" and len(document["rules"]) > 1
+    validator.validate(document)
+    ours[0]["role"] = "listen"
+    assert not validator.is_valid(document)
+
+
+def test_every_versioned_document_has_a_schema_file() -> None:
+    """Each ``archmetrics.NAME/N`` the package writes or reads has NAME-N.schema.json, whose
+    ``$id`` and ``schema`` constant name it, and docs/json.md links it."""
+    package = Path(__file__).resolve().parents[2] / "archmetrics"
+    named = set()
+    for source in package.rglob("*.py"):
+        named |= set(re.findall(r'"archmetrics\.([a-z]+)/([0-9]+)"', source.read_text("utf-8")))
+    assert {"scan", "diff", "graph", "rules", "study"} <= {name for name, _ in named}
+    docs = (package.parent / "docs" / "json.md").read_text("utf-8")
+    shipped = {p.name for p in (resources.files("archmetrics") / "schemas").iterdir()}
+    for name, version in sorted(named):
+        file = f"{name}-{version}.schema.json"
+        assert file in shipped, file
+        schema = _schema(file)
+        Draft202012Validator.check_schema(schema)
+        assert schema["$id"] == f"archmetrics.{name}/{version}"
+        assert schema["properties"]["schema"] == {"const": schema["$id"]}
+        assert f"archmetrics/schemas/{file}" in docs, file

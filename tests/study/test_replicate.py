@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import json
 import subprocess
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import pytest
+from jsonschema import Draft202012Validator
 
 from archmetrics.app.replicate import settings_for, subjects_root
 from archmetrics.cli import main
@@ -95,6 +97,25 @@ def test_measured_shapes(report: Any) -> None:
     # the legacy driver never changes: the new location is untouched after the baseline
     for stage in ("first", "second"):
         assert _total(report, "legacy", "soa", stage, "new")["changes"] == 0
+
+
+def test_the_report_holds_to_its_schema(report: Any) -> None:
+    """report.json against archmetrics/schemas/study-2.schema.json, as the package ships it;
+    a report missing a verdict, with a verdict that is not one, or a stage without its total
+    is refused."""
+    text = (resources.files("archmetrics") / "schemas" / "study-2.schema.json").read_text()
+    schema = json.loads(text)
+    Draft202012Validator.check_schema(schema)
+    validator = Draft202012Validator(schema)
+    validator.validate(report)
+    assert set(report["variants"]) == {"as-described", "idiomatic"}
+    broken = [json.loads(json.dumps(report)) for _ in range(3)]
+    del broken[0]["findings"][0]["variants"]["idiomatic"]["agrees"]
+    broken[1]["findings"][0]["variants"]["idiomatic"]["agrees"] = "maybe"
+    stages = broken[2]["variants"]["idiomatic"]["subjects"]["wdb"]["series"]["soa"]["stages"]
+    del stages[0]["locations"]["total"]
+    for document in broken:
+        assert not validator.is_valid(document)
 
 
 def test_report_and_charts_are_written(study: Path) -> None:
