@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+import re
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from archmetrics.changeset.locations import BadPattern, compile_glob
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, CouplingReport, load_rule_packs, measure_coupling
 from archmetrics.coupling.rules import RulePackError, RuleSet
@@ -23,8 +25,30 @@ def coupling_options(settings: Settings) -> CouplingOptions:
 
 
 def rule_set(settings: Settings, root: Path) -> RuleSet:
-    """The built-in packs, the configured ones (paths relative to the root) and plugins."""
-    return load_rule_packs([pack_path(root, p) for p in settings.coupling.rule_packs])
+    """The built-in packs, the configured ones (paths relative to the root) and plugins; a
+    configuration rule's bad ``files`` glob fails here, naming the pack, rule and key."""
+    packs = load_rule_packs([pack_path(root, p) for p in settings.coupling.rule_packs])
+    configuration_files(packs)
+    return packs
+
+
+def configuration_files(packs: RuleSet) -> Callable[[str], str | None]:
+    """A path's configuration format, by the ``files`` globs of the packs' configuration
+    rules (the first rule, in load order, that names the path decides), or None: which files
+    a scan or diff reads as configuration (docs/metrics.md, "Configuration links")."""
+    globs: list[tuple[re.Pattern[str], str]] = []
+    for pack in packs.packs:
+        for rule in pack.configuration:
+            for glob in rule.files:
+                try:
+                    globs.append((compile_glob(glob), rule.format))
+                except BadPattern as error:
+                    raise RulePackError(pack.source, rule.id, "files", str(error)) from None
+
+    def format_of(path: str) -> str | None:
+        return next((fmt for glob, fmt in globs if glob.fullmatch(path)), None)
+
+    return format_of
 
 
 def pack_path(root: Path, text: str) -> Path:
@@ -39,7 +63,7 @@ def pack_path(root: Path, text: str) -> Path:
     return Path(path)
 
 
-def measure(files: Sequence[FileFacts], settings: Settings, root: Path) -> CouplingReport:
-    """Coupling of the elements the readable ``files`` make up."""
+def measure(files: Sequence[FileFacts], settings: Settings, packs: RuleSet) -> CouplingReport:
+    """Coupling of the elements the readable ``files`` make up, under the rule ``packs``."""
     readable = [f for f in files if f.parsed]
-    return measure_coupling(readable, coupling_options(settings), rule_set(settings, root))
+    return measure_coupling(readable, coupling_options(settings), packs)
