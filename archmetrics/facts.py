@@ -172,6 +172,36 @@ class CallSite(NamedTuple):
     function: str | None = None  # qualified name of the enclosing function, if any
 
 
+class ConfigFormat(StrEnum):
+    """Formats of configuration files a reader turns into :class:`ConfigTable` facts; which
+    files are read as configuration is the rule packs' word (docs/metrics.md)."""
+
+    TOML = "toml"
+
+
+class ConfigTable(NamedTuple):
+    """One table of a configuration file: the raw material for configuration links (thesis
+    p. 110: "linkages that could be modified through configuration information changes
+    without requiring recompilation"), as a call site is for the links code makes.
+
+    ``keys``: the keys leading to it from the document's root, array positions left out, so
+    every ``[[rules.to]]`` table is ``("rules", "to")`` (the root table is ``()``); ``line``:
+    where it is written (its header; for a table written inline, the line of the key holding
+    it); ``values``: its keys that hold text, numbers, booleans or arrays of them, each with
+    its values as text, in the order written. Tables inside it are tables of their own."""
+
+    keys: tuple[str, ...]
+    line: int
+    values: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def get(self, key: str) -> tuple[str, ...] | None:
+        """The values of ``key``, None when the table does not hold it."""
+        for name, values in self.values:
+            if name == key:
+                return values
+        return None
+
+
 class Severity(StrEnum):
     WARNING = "warning"
     ERROR = "error"
@@ -275,7 +305,9 @@ class FileFacts:
     """Everything archmetrics knows about one file version.
 
     ``statements``, ``call_sites`` and ``bindings`` are tuples from a parser,
-    :class:`Deferred` from the cache."""
+    :class:`Deferred` from the cache. A configuration file (``language`` a
+    :class:`ConfigFormat`) has ``tables`` and nothing else: it is no executable code, so it
+    adds nothing to λ or v_g, only links."""
 
     path: str
     language: str
@@ -289,6 +321,7 @@ class FileFacts:
     warnings: tuple[ParseWarning, ...] = ()
     parsed: bool = True  # False: the parser could not read it at all (reported, not guessed)
     generated: bool = False  # the file declares itself generated ("@generated", "DO NOT EDIT")
+    tables: tuple[ConfigTable, ...] = ()  # a configuration file's tables (ConfigFormat)
 
     def callees(self) -> frozenset[str]:
         """The callees of the file's call sites (read without decoding them, if cached)."""

@@ -34,11 +34,16 @@ def select(
     snapshot: Snapshot,
     table: LanguageTable,
     keep: Callable[[str], bool] = lambda path: True,
+    configuration: Callable[[str], str | None] | None = None,
 ) -> tuple[Selected, ...]:
-    """The files of ``snapshot`` that have a language and that ``keep`` accepts."""
+    """The files of ``snapshot`` that have a language and that ``keep`` accepts: source by
+    its ending, else configuration in the format ``configuration`` (from the rule packs,
+    :func:`archmetrics.app.coupling.configuration_files`) gives for its path."""
     chosen = []
     for file in snapshot.files():
         language = table.language_of(file.path)
+        if language is None and configuration is not None:
+            language = configuration(file.path)
         if language is not None and keep(file.path):
             chosen.append(Selected(file, language))
     return tuple(chosen)

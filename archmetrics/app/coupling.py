@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, CouplingReport, load_rule_packs, measure_coupling
 from archmetrics.coupling.rules import RulePackError, RuleSet
 from archmetrics.facts import FileFacts
+from archmetrics.globs import BadPattern, compile_glob, normalize_path
+
+if TYPE_CHECKING:
+    from pathspec import GitIgnoreSpec
 
 
 def coupling_options(settings: Settings) -> CouplingOptions:
@@ -23,8 +28,33 @@ def coupling_options(settings: Settings) -> CouplingOptions:
 
 
 def rule_set(settings: Settings, root: Path) -> RuleSet:
-    """The built-in packs, the configured ones (paths relative to the root) and plugins."""
-    return load_rule_packs([pack_path(root, p) for p in settings.coupling.rule_packs])
+    """The built-in packs, the configured ones (paths relative to the root) and plugins; a
+    configuration rule's bad ``files`` glob fails here, naming the pack, rule and key."""
+    packs = load_rule_packs([pack_path(root, p) for p in settings.coupling.rule_packs])
+    configuration_files(packs)
+    return packs
+
+
+def configuration_files(packs: RuleSet) -> Callable[[str], str | None]:
+    """A path's configuration format, by the ``files`` globs of the packs' configuration
+    rules (the first rule, in load order, that names the path decides), or None: which files
+    a scan or diff reads as configuration (docs/metrics.md, "Configuration links")."""
+    globs: list[tuple[GitIgnoreSpec, str]] = []
+    for pack in packs.packs:
+        for rule in pack.configuration:
+            for glob in rule.files:
+                try:
+                    globs.append((compile_glob(glob), rule.format))
+                except BadPattern as error:
+                    raise RulePackError(pack.source, rule.id, "files", str(error)) from None
+
+    def format_of(path: str) -> str | None:
+        if not globs:
+            return None
+        clean = normalize_path(path)
+        return next((fmt for glob, fmt in globs if glob.match_file(clean)), None)
+
+    return format_of
 
 
 def pack_path(root: Path, text: str) -> Path:
@@ -39,7 +69,7 @@ def pack_path(root: Path, text: str) -> Path:
     return Path(path)
 
 
-def measure(files: Sequence[FileFacts], settings: Settings, root: Path) -> CouplingReport:
-    """Coupling of the elements the readable ``files`` make up."""
+def measure(files: Sequence[FileFacts], settings: Settings, packs: RuleSet) -> CouplingReport:
+    """Coupling of the elements the readable ``files`` make up, under the rule ``packs``."""
     readable = [f for f in files if f.parsed]
-    return measure_coupling(readable, coupling_options(settings), rule_set(settings, root))
+    return measure_coupling(readable, coupling_options(settings), packs)

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from archmetrics.app.collect import parse_all, select, worker_limits
-from archmetrics.app.coupling import coupling_options, rule_set
+from archmetrics.app.coupling import configuration_files, coupling_options, rule_set
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, Coupling, LocationRules, compute_change
@@ -313,7 +313,8 @@ def parse_side(
     cache: FactsCache | None,
     blobs: dict[str, str] | None = None,
 ) -> tuple[FileFacts, ...]:
-    selected = select(snapshot, LanguageTable.default(dict(options.languages)))
+    table = LanguageTable.default(dict(options.languages))
+    selected = select(snapshot, table, configuration=configuration_files(options.packs))
     overrides = options.languages
     return parse_all(
         snapshot, selected, overrides, options.jobs, progress, cache, options.limits, blobs

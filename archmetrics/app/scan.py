@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from archmetrics.app.collect import parse_all, select, worker_limits
-from archmetrics.app.coupling import measure
+from archmetrics.app.coupling import configuration_files, measure, rule_set
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import ExcludedFile
@@ -103,13 +103,17 @@ def run_scan(
     root, snapshot, prefixes = _locate(request)
     overrides = request.settings.languages
     table = LanguageTable.default(dict(overrides))
-    selected = select(snapshot, table, lambda path: _under(path, prefixes))
+    packs = rule_set(request.settings, root)  # they say which files are configuration
+    configuration = configuration_files(packs)
+    selected = select(snapshot, table, lambda path: _under(path, prefixes), configuration)
     if not selected and request.rev is None and prefixes and len(request.paths) == 1:
         # a folder git ignores (a virtualenv, a build tree) is read as the plain folder it is
         folder = resolve_path(request.paths[0])
         if folder.is_dir():
             root, snapshot, prefixes = folder, DirectorySnapshot(folder), ()
-            selected = select(snapshot, table)
+            packs = rule_set(request.settings, root)
+            configuration = configuration_files(packs)
+            selected = select(snapshot, table, configuration=configuration)
     # the configuration's `exclude` leaves files out; they are listed, with the folders a
     # plain folder's walk left out
     rules = LocationRules((), request.settings.exclude)
@@ -125,7 +129,7 @@ def run_scan(
     facts = parse_all(snapshot, selected, overrides, jobs, progress, cache, limits)
     progress.phase("coupling")
     metrics = tuple(file_metrics(f) for f in facts)
-    coupling = measure(facts, request.settings, root)
+    coupling = measure(facts, request.settings, packs)
     progress.stop()
     report = ScanReport(
         root=str(root),

@@ -116,6 +116,11 @@ def _status(pre: Metrics | None, post: Metrics | None, changes: int) -> Status:
     return Status.MODIFIED if changes else Status.UNCHANGED
 
 
+def _reconfigured(pairs: Sequence[FilePair]) -> int:
+    """How many of the files changed their configuration tables (facts.ConfigTable)."""
+    return sum(1 for p in pairs if p.pre and p.post and p.pre.tables != p.post.tables)
+
+
 def element_change(
     element: str,
     pairs: Sequence[FilePair],
@@ -141,7 +146,8 @@ def element_change(
         element=element,
         location=_location(element, pairs, rules, notes),
         files=tuple(sorted(p.path for p in pairs)),
-        status=_status(pre, post, added + removed + modified),
+        # a configuration file has no statements: a change of its tables is its change
+        status=_status(pre, post, added + removed + modified + _reconfigured(pairs)),
         pre=pre,
         post=post,
         added=added,

@@ -43,9 +43,11 @@ def replicate_command(args: argparse.Namespace) -> int:
 
 
 def write_charts(report: StudyReport, folder: Path) -> dict[str, list[str]]:
-    """Every chart of every variant and subject as PNG and SVG, in one folder per variant; the
-    PNG names per "<variant>/<subject>", for report.md."""
+    """Every chart of every variant and subject as PNG and SVG, in one folder per variant (the
+    ``*_total`` charts over base + framework, the findings' scope); the PNG names per
+    "<variant>/<subject>", for report.md."""
     from archmetrics.reports.charts import render_all
+    from archmetrics.reports.charts_data import INTEGRATION
 
     written: dict[str, list[str]] = {}
     for variant in report.variants:
@@ -53,7 +55,8 @@ def write_charts(report: StudyReport, folder: Path) -> dict[str, list[str]]:
         for result in variant.subjects:
             key = f"{variant.variant}/{result.subject}"
             for fmt in ("png", "svg"):
-                for stem, data in render_all(result.compare, fmt).items():
+                # the summary charts over base + framework, where the findings are judged
+                for stem, data in render_all(result.compare, fmt, INTEGRATION).items():
                     name = f"{key}-{stem}.{fmt}"
                     (folder / name).write_bytes(data)
                     if fmt == "png":

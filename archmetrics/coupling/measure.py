@@ -6,6 +6,7 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 
 from archmetrics.coupling.bindings import module_bindings
+from archmetrics.coupling.config_links import with_config_sites
 from archmetrics.coupling.dynamic import LinkFilter, file_link_sites, resolve
 from archmetrics.coupling.elements import Element, element_of_file, group_elements
 from archmetrics.coupling.endpoints import Lookup, Value, constants_of
@@ -56,6 +57,7 @@ def measure_coupling(
     dependencies = {e.name: element_dependencies(e, occurrences, element_of) for e in elements}
     constants = _Constants(by_path)
     found = _Sites(by_path, occurrences, rules, constants, memo).of(elements)
+    found = with_config_sites(found, elements, by_path, rules.configuration)
     sites = resolve({e.name: found[e.name] for e in elements})
     afferent = dependents(dependencies)
     incoming = _incoming(sites)

@@ -115,11 +115,51 @@ class Rule:
 
 
 @dataclass(frozen=True, slots=True)
+class ConfigEndpoint:
+    """Where a configuration link's endpoint is: the values of ``key`` in its table, each
+    normalized as ``type`` (``pattern``, when given, picks the part of the value to keep:
+    group 1, or the whole match)."""
+
+    type: str
+    key: str
+    pattern: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class ConfigRule:
+    """A configuration-link rule of a pack (thesis p. 110: "linkages that could be modified
+    through configuration information changes without requiring recompilation"): the files
+    (``files`` globs) read as configuration in ``format``, the tables of them that are links
+    (``table``: the keys leading to them; ``when``: values some of their keys must hold,
+    ``defaults`` standing in for a key the table leaves out), and where the endpoint is. Each
+    value of the endpoint's key in such a table is one link site (+1 d_e)."""
+
+    pack: str
+    id: str
+    files: tuple[str, ...]
+    format: str
+    table: tuple[str, ...]
+    kind: LinkKind
+    role: Role
+    endpoint: ConfigEndpoint
+    when: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    defaults: tuple[tuple[str, str], ...] = ()
+    description: str = ""
+    example: str = ""  # a configuration file in ``format`` holding one such link
+    example_endpoint: str | None = None
+
+    @property
+    def qualified_id(self) -> str:
+        return f"{self.pack}/{self.id}"
+
+
+@dataclass(frozen=True, slots=True)
 class RulePack:
     name: str
     source: str
     description: str
     rules: tuple[Rule, ...]
+    configuration: tuple[ConfigRule, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,3 +174,8 @@ class RuleSet:
 
     def for_language(self, language: str) -> tuple[Rule, ...]:
         return tuple(r for r in self.rules if language in r.languages)
+
+    @property
+    def configuration(self) -> tuple[ConfigRule, ...]:
+        """The configuration-link rules of every pack, in load order."""
+        return tuple(rule for pack in self.packs for rule in pack.configuration)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from archmetrics.coupling.rules import EndpointSource, EndpointSpec, Rule, RuleSet
+from archmetrics.coupling.rules import ConfigRule, EndpointSource, EndpointSpec, Rule, RuleSet
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,9 +62,34 @@ def rule_row(rule: Rule) -> RuleRow:
     )
 
 
+def config_row(rule: ConfigRule) -> RuleRow:
+    """A configuration rule as text cells: its format as the language, the files and the
+    tables it reads as what it matches."""
+    when = "; ".join(f"{key} = {' | '.join(values)}" for key, values in rule.when)
+    defaults = ", ".join(f"{key} = {value}" for key, value in rule.defaults)
+    match = f"{', '.join(rule.files)}: [{'.'.join(rule.table)}]"
+    match += f" where {when}" if when else ""
+    match += f" (default {defaults})" if defaults else ""
+    pattern = f" ~ {rule.endpoint.pattern}" if rule.endpoint.pattern else ""
+    return RuleRow(
+        pack=rule.pack,
+        rule=rule.id,
+        language=f"{rule.format} (configuration)",
+        match=match,
+        kind=rule.kind.value,
+        role=rule.role.value,
+        endpoint=f"{rule.endpoint.type}: key {rule.endpoint.key}{pattern}",
+    )
+
+
 def rule_rows(rules: RuleSet) -> tuple[RuleRow, ...]:
-    """Every rule in force, in load order: the rows of ``archmetrics rules``."""
-    return tuple(rule_row(rule) for rule in rules.rules)
+    """Every rule in force, in load order, each pack's configuration rules after its code
+    rules: the rows of ``archmetrics rules``."""
+    return tuple(
+        row
+        for pack in rules.packs
+        for row in (*map(rule_row, pack.rules), *map(config_row, pack.configuration))
+    )
 
 
 def _cell(text: str) -> str:
@@ -82,7 +107,7 @@ def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
     for pack in rules.packs:
         lines += [f"{heading} `{pack.name}`", "", pack.description, "", header,
                   "|---|---|---|---|---|---|---|"]  # fmt: skip
-        for row in (rule_row(rule) for rule in pack.rules):
+        for row in (*map(rule_row, pack.rules), *map(config_row, pack.configuration)):
             cells = (row.rule, row.language, row.match, row.kind, row.role, row.endpoint,
                      row.requires)  # fmt: skip
             lines.append("| " + " | ".join(_code(c) for c in cells) + " |")

@@ -37,7 +37,7 @@ _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 
 
 @dataclass(frozen=True, slots=True)
-class _Where:
+class Where:
     source: str
     rule: str | None = None
 
@@ -90,27 +90,30 @@ def _list(values: frozenset[str]) -> str:
 
 def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
     """Validate one decoded TOML document and build its :class:`RulePack`."""
-    top = _Where(source)
-    top.table(data, "", frozenset({"pack", "rules"}))
+    from archmetrics.coupling.validate_config import parse_configuration
+
+    top = Where(source)
+    top.table(data, "", frozenset({"pack", "rules", "configuration"}))
     pack = top.table(data.get("pack"), "pack", _PACK_KEYS)
     name = top.text(pack, "name")
     if not _ID.match(name):
         top.fail("pack.name", f"{name!r} must be letters, digits and _.+-")
-    raw_rules = data.get("rules")
-    if not isinstance(raw_rules, list) or not raw_rules:
-        top.fail("rules", "a pack needs a non-empty [[rules]] array")
+    raw_rules = data.get("rules", [])
+    if not isinstance(raw_rules, list) or not (raw_rules or "configuration" in data):
+        top.fail("rules", "a pack needs a non-empty [[rules]] or [[configuration]] array")
     rules = tuple(_parse_rule(raw, name, source, index) for index, raw in enumerate(raw_rules))
+    configuration = parse_configuration(data.get("configuration", []), name, source)
     seen: set[str] = set()
-    for rule in rules:
-        if rule.id in seen:
-            _Where(source, rule.id).fail("id", "duplicate rule id in this pack")
-        seen.add(rule.id)
-    return RulePack(name, source, top.text(pack, "description", ""), rules)
+    for ident in [r.id for r in rules] + [r.id for r in configuration]:
+        if ident in seen:
+            Where(source, ident).fail("id", "duplicate rule id in this pack")
+        seen.add(ident)
+    return RulePack(name, source, top.text(pack, "description", ""), rules, configuration)
 
 
 def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
     rule_id = raw.get("id") if isinstance(raw, Mapping) else None
-    where = _Where(source, rule_id if isinstance(rule_id, str) else f"#{index + 1}")
+    where = Where(source, rule_id if isinstance(rule_id, str) else f"#{index + 1}")
     table = where.table(raw, "", _RULE_KEYS)
     ident = where.text(table, "id")
     if not _ID.match(ident):
@@ -142,7 +145,7 @@ def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
 
 
 def _examples(
-    where: _Where, raw: object, languages: tuple[str, ...]
+    where: Where, raw: object, languages: tuple[str, ...]
 ) -> tuple[tuple[str, str], ...]:
     """``example = "..."`` (in the rule's first language) or ``[rules.example]`` by language."""
     if raw is None:
@@ -155,14 +158,14 @@ def _examples(
     return tuple((language, str(text)) for language, text in table.items())
 
 
-def _patterns(where: _Where, table: Mapping[str, object]) -> tuple[str, ...]:
+def _patterns(where: Where, table: Mapping[str, object]) -> tuple[str, ...]:
     patterns = where.texts(table, "match", required=True)
     for pattern in patterns:
         _check_glob(where, "match", pattern)
     return patterns
 
 
-def _check_glob(where: _Where, key: str, pattern: str) -> None:
+def _check_glob(where: Where, key: str, pattern: str) -> None:
     """A ``match`` pattern: a dotted callee name with globs of the one dialect (globs.py)."""
     if any(c.isspace() for c in pattern) or "(" in pattern or "/" in pattern:
         where.fail(key, f"{pattern!r}: a pattern is a dotted callee name with * globs")
@@ -172,7 +175,7 @@ def _check_glob(where: _Where, key: str, pattern: str) -> None:
         where.fail(key, str(error))
 
 
-def _parse_endpoint(where: _Where, raw: object) -> EndpointSpec:
+def _parse_endpoint(where: Where, raw: object) -> EndpointSpec:
     table = where.table(raw, "endpoint", _ENDPOINT_KEYS)
     try:
         spec = _endpoint_fields(where, table)
@@ -185,7 +188,7 @@ def _parse_endpoint(where: _Where, raw: object) -> EndpointSpec:
     return spec
 
 
-def _endpoint_fields(where: _Where, table: Mapping[str, object]) -> EndpointSpec:
+def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
     pattern = table.get("pattern")
     if pattern is not None:
         if not isinstance(pattern, str):
@@ -212,7 +215,7 @@ def _endpoint_fields(where: _Where, table: Mapping[str, object]) -> EndpointSpec
     )
 
 
-def _parse_hint(where: _Where, raw: object) -> FunctionHint:
+def _parse_hint(where: Where, raw: object) -> FunctionHint:
     table = where.table(raw, "endpoint.same_function", _HINT_KEYS)
     try:
         match = where.text(table, "match")

@@ -6,7 +6,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
 
-from archmetrics.facts import FileFacts, Language, ParseWarning, Severity
+from archmetrics.facts import ConfigFormat, FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import text
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, too_large
 
@@ -73,10 +73,19 @@ def _cpp(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFa
     return c_family.parse(path, source, Language.CPP, limits)
 
 
+def _toml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    from archmetrics.parsers import config_toml
+
+    return config_toml.parse(path, source, limits)
+
+
 BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     LanguageSpec(Language.PYTHON, _python, _python),
     LanguageSpec(Language.C, _c, _c),
     LanguageSpec(Language.CPP, _cpp, _cpp),
+    # configuration formats: no file ending maps to them; the rule packs say which files
+    # are configuration (docs/metrics.md, "Configuration links")
+    LanguageSpec(ConfigFormat.TOML, _toml, _toml),
 )
 
 

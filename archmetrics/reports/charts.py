@@ -11,25 +11,33 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import PurePath
 
-from archmetrics.reports.charts_data import COST, COUPLING, SCALED_CHANGES, SCALED_COMPLEXITY
+from archmetrics.reports.charts_data import (
+    COST,
+    COUPLING,
+    SCALED_CHANGES,
+    SCALED_COMPLEXITY,
+    TOTAL,
+    Scope,
+)
 from archmetrics.reports.charts_layout import Chart, by_location, coupling, totals
 from archmetrics.reports.model import CompareReport, SeriesReport
 
 FORMATS = ("png", "svg")
 
-_KINDS: dict[str, Callable[[CompareReport], Chart]] = {
-    "coupling": lambda r: coupling(r, COUPLING),
-    "scaled_changes": lambda r: by_location(r, SCALED_CHANGES),
-    "scaled_complexity": lambda r: by_location(r, SCALED_COMPLEXITY),
-    "cost": lambda r: by_location(r, COST),
-    "coupling_total": lambda r: totals(r, COUPLING, "Summary of coupling changes"),
-    "scaled_changes_total": lambda r: totals(
-        r, (SCALED_CHANGES,), "Code volume change across stages"
+# kind -> its chart of a comparison; the summary kinds add up the scope's locations
+_KINDS: dict[str, Callable[[CompareReport, Scope], Chart]] = {
+    "coupling": lambda r, _: coupling(r, COUPLING),
+    "scaled_changes": lambda r, _: by_location(r, SCALED_CHANGES),
+    "scaled_complexity": lambda r, _: by_location(r, SCALED_COMPLEXITY),
+    "cost": lambda r, _: by_location(r, COST),
+    "coupling_total": lambda r, s: totals(r, COUPLING, "Summary of coupling changes", s),
+    "scaled_changes_total": lambda r, s: totals(
+        r, (SCALED_CHANGES,), "Code volume change across stages", s
     ),
-    "scaled_complexity_total": lambda r: totals(
-        r, (SCALED_COMPLEXITY,), "Complexity change across stages"
+    "scaled_complexity_total": lambda r, s: totals(
+        r, (SCALED_COMPLEXITY,), "Complexity change across stages", s
     ),
-    "cost_total": lambda r: totals(r, (COST,), "Complexity change cost across stages"),
+    "cost_total": lambda r, s: totals(r, (COST,), "Complexity change cost across stages", s),
 }
 
 # kind -> the thesis figures whose organisation it reproduces
@@ -55,22 +63,25 @@ def chart_kinds() -> tuple[str, ...]:
     return tuple(_KINDS)
 
 
-def chart_of(report: CompareReport, kind: str) -> Chart:
-    """The pure description of a chart (what ``render_compare_chart`` draws)."""
+def chart_of(report: CompareReport, kind: str, scope: Scope = TOTAL) -> Chart:
+    """The pure description of a chart (what ``render_compare_chart`` draws); the ``*_total``
+    kinds add up the ``scope``'s locations (the thesis's total by default)."""
     if kind not in _KINDS:
         raise ChartError(f"unknown chart kind {kind!r}: expected one of {', '.join(_KINDS)}")
     if not report.series or not any(s.stages for _, s in report.series):
         raise ChartError("nothing to chart: the report has no stages")
-    return _KINDS[kind](report)
+    return _KINDS[kind](report, scope)
 
 
-def render_compare_chart(report: CompareReport, kind: str, fmt: str = "png") -> bytes:
+def render_compare_chart(
+    report: CompareReport, kind: str, fmt: str = "png", scope: Scope = TOTAL
+) -> bytes:
     """One chart of several approaches side by side, as PNG or SVG bytes."""
     if fmt not in FORMATS:
         raise ChartError(f"unknown chart format {fmt!r}: expected one of {', '.join(FORMATS)}")
     from archmetrics.reports import charts_draw  # matplotlib: imported only to draw
 
-    return charts_draw.render(chart_of(report, kind), fmt)
+    return charts_draw.render(chart_of(report, kind, scope), fmt)
 
 
 def series_name(report: SeriesReport) -> str:
@@ -83,6 +94,7 @@ def render_series_chart(report: SeriesReport, kind: str, fmt: str = "png") -> by
     return render_compare_chart(CompareReport(((series_name(report), report),)), kind, fmt)
 
 
-def render_all(report: CompareReport, fmt: str = "png") -> dict[str, bytes]:
-    """Every kind of chart of the study, keyed by file stem (the kind's name)."""
-    return {kind: render_compare_chart(report, kind, fmt) for kind in _KINDS}
+def render_all(report: CompareReport, fmt: str = "png", scope: Scope = TOTAL) -> dict[str, bytes]:
+    """Every kind of chart of the study, keyed by file stem (the kind's name); the summary
+    kinds over ``scope``."""
+    return {kind: render_compare_chart(report, kind, fmt, scope) for kind in _KINDS}

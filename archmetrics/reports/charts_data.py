@@ -10,7 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from archmetrics.changeset.locations import Location
 from archmetrics.changeset.model import Summary
+from archmetrics.changeset.scope import scope_summary
 from archmetrics.reports.model import CompareReport, SeriesReport
 
 LOCATIONS = ("base", "new", "framework")
@@ -145,3 +147,33 @@ def stage_value(
     return read_value(
         summary_at(series, stage, location), field, f"{approach} has no stage {stage!r}"
     )
+
+
+@dataclass(frozen=True, slots=True)
+class Scope:
+    """The locations a summary chart adds up, and how its symbols and title say so: the
+    thesis's totals (Figs 8.1-8.4) are over base, new and framework; the study judges its
+    findings on base + framework (docs/study.md), and charts them there."""
+
+    locations: tuple[Location, ...]
+    subscript: str  # in the symbols: E_{tot}, E_{B+F}
+    label: str  # in the title
+
+    def symbol(self, measure: Measure) -> str:
+        """The measure's total symbol with this scope's subscript (``$E_{B+F}$``)."""
+        return measure.total.replace("tot}", f"{self.subscript}}}")
+
+    def value(self, series: SeriesReport, approach: str, stage: str, field: str) -> Value:
+        """The charted value of ``field`` over this scope's locations at ``stage``."""
+        if self.locations == TOTAL.locations:
+            return stage_value(series, approach, stage, "total", field)
+        for s in series.stages:
+            if s.label == stage:
+                return read_value(scope_summary(s.report.change, self.locations), field)
+        return read_value(None, field, f"{approach} has no stage {stage!r}")
+
+
+TOTAL = Scope(
+    (Location.BASE, Location.NEW, Location.FRAMEWORK), "tot", "total of base, new and framework"
+)
+INTEGRATION = Scope((Location.BASE, Location.FRAMEWORK), "B+F", "base + framework")

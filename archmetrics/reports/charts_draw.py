@@ -51,6 +51,7 @@ _TEX = {
 }
 _LOCK = threading.Lock()
 _FOOT_LINE = 0.16  # inches per footnote line at 8 pt
+_MARGIN = 0.1  # inches between the drawing and the image's edge
 _WRAP = 150  # characters per footnote line at 10 in
 
 
@@ -237,6 +238,7 @@ def _legend(fig: Figure, chart: Chart) -> None:
     fig.legend(
         handles=handles,
         loc="outside right upper",
+        borderaxespad=_MARGIN * DPI / 10,  # in font sizes: clear of the image's edge
         title=chart.legend_title,
         fontsize=10,
         frameon=False,
@@ -249,7 +251,11 @@ def _figure(chart: Chart) -> Figure:
     lines = notes.lines()
     foot = (len(lines) * _FOOT_LINE + 0.08) / chart.size[1] if lines else 0.0
     fig = Figure(figsize=chart.size, dpi=DPI)
-    fig.set_layout_engine(ConstrainedLayoutEngine(rect=(0, foot, 1, 1 - foot)))
+    # a margin all round, so the title and the legend never touch the image's edge
+    inset = (_MARGIN / chart.size[0], _MARGIN / chart.size[1])
+    rect = (inset[0], foot + inset[1], 1 - 2 * inset[0], 1 - foot - 2 * inset[1])
+    layout = ConstrainedLayoutEngine(rect=rect)
+    fig.set_layout_engine(layout)
     FigureCanvasAgg(fig)
     _axes(fig, chart, notes)
     fig.supylabel(chart.ylabel, fontsize=11)

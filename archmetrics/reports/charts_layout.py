@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 from archmetrics.reports.charts_data import (
     LOCATIONS,
+    TOTAL,
     Measure,
+    Scope,
     Value,
     stage_labels,
     stage_revisions,
@@ -61,9 +63,11 @@ class Chart:
     legend_title: str
 
 
-def axis_label(measure: Measure, total: bool = False) -> str:
-    """E.g. "Γ'  scaled code size change" over "[logical lines × λ̂]"."""
-    return f"{measure.total if total else measure.symbol}  {measure.name}\n[{measure.unit}]"
+def axis_label(measure: Measure, scope: Scope | None = None) -> str:
+    """E.g. "Γ'  scaled code size change" over "[logical lines × λ̂]"; with a ``scope``, its
+    symbol (Γ'_tot, Γ'_B+F)."""
+    symbol = scope.symbol(measure) if scope else measure.symbol
+    return f"{symbol}  {measure.name}\n[{measure.unit}]"
 
 
 def literal(text: str) -> str:
@@ -145,18 +149,21 @@ def coupling(report: CompareReport, measures: tuple[Measure, ...]) -> Chart:
     )
 
 
-def totals(report: CompareReport, measures: tuple[Measure, ...], title: str) -> Chart:
-    """One panel per measure; stages along x; a bar per approach (Figs 8.1-8.4, 12.4-12.6)."""
+def totals(
+    report: CompareReport, measures: tuple[Measure, ...], title: str, scope: Scope = TOTAL
+) -> Chart:
+    """One panel per measure; stages along x; a bar per approach (Figs 8.1-8.4, 12.4-12.6),
+    each the sum over the ``scope``'s locations, which the title names."""
     stages = stage_labels(report)
     panels = tuple(
         Panel(
-            f"{m.total}  {m.name}" if len(measures) > 1 else "",
+            f"{scope.symbol(m)}  {m.name}" if len(measures) > 1 else "",
             stage_ticks(report, stages),
             tuple(
                 Bars(
                     literal(name),
                     APPROACH_COLOURS[i % len(APPROACH_COLOURS)],
-                    tuple(stage_value(series, name, st, "total", m.field) for st in stages),
+                    tuple(scope.value(series, name, st, m.field) for st in stages),
                 )
                 for i, (name, series) in enumerate(report.series)
             ),
@@ -165,8 +172,8 @@ def totals(report: CompareReport, measures: tuple[Measure, ...], title: str) -> 
     )
     single = len(measures) == 1
     return Chart(
-        f"{title}: {approaches_of(report)}",
-        axis_label(measures[0], total=True) if single else "total change\n[links]",
+        f"{title}, {scope.label}: {approaches_of(report)}",
+        axis_label(measures[0], scope) if single else "coupling change\n[links]",
         "stage",
         panels,
         (1, 1) if single else (2, (len(panels) + 1) // 2),

@@ -32,6 +32,7 @@ from archmetrics.facts import (
     Binding,
     CallSite,
     Class,
+    ConfigTable,
     Decision,
     Deferred,
     Dependency,
@@ -45,7 +46,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 7
+FORMAT = 8
 BODY_LINES = 3  # call sites, statements, bindings
 
 _new = tuple.__new__
@@ -98,6 +99,7 @@ def encode(facts: FileFacts) -> bytes:
         [[w.line, w.message, str(w.severity)] for w in facts.warnings],
         facts.parsed,
         facts.generated,
+        [[list(t.keys), t.line, [[k, list(vs)] for k, vs in t.values]] for t in facts.tables],
     ]
     # four lines: JSON escapes the newlines inside strings
     return b"\n".join((_json(document), calls, statements, bindings))
@@ -279,6 +281,7 @@ def _decode(
         warnings,
         parsed,
         generated,
+        tables,
     ) = json.loads(head)
     if fmt != FORMAT:
         raise CodecError(f"facts format {fmt!r}, expected {FORMAT}")
@@ -342,7 +345,16 @@ def _decode(
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
         parsed=parsed,
         generated=generated,
+        tables=tuple([_table(keys, line, values) for keys, line, values in tables]),
     )
+
+
+def _table(keys: list[Any], line: Any, values: list[Any]) -> ConfigTable:
+    """A configuration table read back, every part checked (the cache is not trusted)."""
+    texts = [*keys, *(k for k, _ in values), *(v for _, vs in values for v in vs)]
+    if not all(isinstance(t, str) for t in texts) or type(line) is not int or line < 1:
+        raise CodecError("a configuration table of other than text and a line")
+    return ConfigTable(tuple(keys), line, tuple((k, tuple(vs)) for k, vs in values))
 
 
 def decode(

@@ -10,8 +10,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
-from archmetrics.changeset.cost import Sums, location_summary
-from archmetrics.changeset.model import Metrics, Summary
+from archmetrics.changeset.locations import Location
+from archmetrics.changeset.model import Summary
+from archmetrics.changeset.scope import scope_summary
 from archmetrics.reports.model import CompareReport, DiffReport, SeriesReport
 
 LATER = ("first", "second")  # the stages after the baseline
@@ -43,15 +44,7 @@ def integration_summary(report: DiffReport) -> Summary:
     so claims about what an approach costs are tested on the code around it: the client
     (base) and what the approach supplies or requires (framework).
     """
-    chosen = [e for e in report.change.elements if e.location.value in ("base", "framework")]
-    sums = Sums(
-        pre=sum((e.pre or Metrics() for e in chosen), Metrics()),
-        post=sum((e.post or Metrics() for e in chosen), Metrics()),
-        added=sum(e.added for e in chosen),
-        removed=sum(e.removed for e in chosen),
-        modified=sum(e.modified for e in chosen),
-    )
-    return location_summary(sums, ())
+    return scope_summary(report.change, (Location.BASE, Location.FRAMEWORK))
 
 
 def summary(series: SeriesReport, stage: str, location: str = INTEGRATION) -> Summary:

@@ -251,7 +251,13 @@ def render_markdown(
             parts.append("")
             rows = diff_rows.compare_rows(r.compare)
             parts.append(table(list(diff_rows.TREND_HEADER), rows, "lll" + "r" * 10))
-            for image in charts.get(f"{result.variant}/{r.subject}", []):
+            images = charts.get(f"{result.variant}/{r.subject}", [])
+            if images:
+                parts.append(
+                    "Charts: by location, and the summaries (`*_total`) over base + framework,"
+                    " the scope the findings are judged on.\n"
+                )
+            for image in images:
                 parts.append(f"![{image}](charts/{image})\n")
     parts.append("## Appendix: every element, stage by stage\n")
     parts.append(

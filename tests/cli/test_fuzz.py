@@ -158,9 +158,47 @@ def _toml_table(name: str, table: dict[str, Any]) -> str:
 
 def _pack_toml(pack: dict[str, Any]) -> str:
     text = _toml_table("pack", pack["pack"])
-    for rule in pack["rules"]:
-        text += "\n" + _toml_table("[rules]", rule)
+    for array in ("rules", "configuration"):
+        for rule in pack.get(array, []):
+            text += "\n" + _toml_table(f"[{array}]", rule)
     return text
+
+
+FILE_GLOBS = st.sampled_from(["rules.toml", "*.toml", "[", "!x"]) | GLOBS
+
+
+@st.composite
+def configuration_packs(draw: st.DrawFn) -> dict[str, Any]:
+    """Packs of [[configuration]] rules, valid or not, reading routes from rules.toml files."""
+    entries = []
+    for number in range(draw(st.integers(1, 3))):
+        entry: dict[str, Any] = {
+            "id": draw(st.sampled_from([f"c{number}", "", "bad id"])),
+            "files": draw(st.lists(FILE_GLOBS, max_size=3)),
+            "format": draw(st.sampled_from(["toml", "yaml"])),
+            "table": draw(st.sampled_from(["rules.to", "rules", "", "a..b", "routes"])),
+            "kind": draw(st.sampled_from(["messaging", "config", "nonsense"])),
+            "role": draw(st.sampled_from(["initiate", "receive", "both"])),
+            "endpoint": {
+                "type": draw(st.sampled_from(["service", "topic", "x"])),
+                "key": draw(st.sampled_from(["service", "topic", ""])),
+                **({"pattern": draw(REGEXES)} if draw(st.booleans()) else {}),
+            },
+        }
+        if draw(st.booleans()):
+            entry["when"] = {"kind": draw(st.lists(st.sampled_from(["send", "request", 3])))}
+        if draw(st.booleans()):
+            entry["defaults"] = {"kind": draw(st.sampled_from(["request", 4]))}
+        entries.append(entry)
+    return {"pack": {"name": "fuzzcfg"}, "configuration": entries}
+
+
+ROUTER_FILES = st.one_of(
+    st.text(alphabet='[]{}=."\'#\n \\rulestokindsvc01', max_size=300),
+    st.lists(st.sampled_from(["service", "topic", "kind", "to"]), max_size=6).map(
+        lambda keys: "[[rules]]\n" + "".join(f'[[rules.to]]\n{k} = "{k}"\n' for k in keys)
+    ),
+)
 
 
 # ------------------------------------------------------------------------------ harness
@@ -267,6 +305,16 @@ def test_random_source_files(committed: dict[str, bytes], worktree: dict[str, by
 def test_random_configurations(config: str) -> None:
     _check({"a.py": b"def f(a):\n    return a or 1\n"}, {"b.c": b"int g(int x){return x?1:2;}"},
            config)  # fmt: skip
+
+
+@FUZZ
+@given(configuration_packs(), ROUTER_FILES, ROUTER_FILES)
+def test_random_configuration_rules_and_router_files(
+    pack: dict[str, Any], committed: str, edited: str
+) -> None:
+    config = '[tool.archmetrics.coupling]\nrule-packs = ["pack.toml"]\n'
+    _check({"rules.toml": committed.encode(), "a/x.rules.toml": edited.encode()},
+           {"rules.toml": edited.encode()}, config, _pack_toml(pack))  # fmt: skip
 
 
 @FUZZ

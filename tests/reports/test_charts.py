@@ -13,6 +13,7 @@ import pytest
 from matplotlib.image import imread
 
 from archmetrics.app.series import run_compare
+from archmetrics.changeset.model import Summary
 from archmetrics.reports.charts import (
     THESIS_FIGURES,
     ChartError,
@@ -23,7 +24,8 @@ from archmetrics.reports.charts import (
     render_series_chart,
     series_name,
 )
-from archmetrics.reports.charts_data import LOCATIONS
+from archmetrics.reports.charts_data import COUPLING as COUPLING_MEASURES
+from archmetrics.reports.charts_data import INTEGRATION, LOCATIONS
 from archmetrics.reports.charts_draw import _figure
 from archmetrics.reports.charts_layout import APPROACH_COLOURS, LOCATION_COLOURS
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
@@ -142,10 +144,14 @@ def test_svg_and_png_carry_the_plain_title(svgs: dict[str, bytes], pngs: dict[st
     assert expected.encode() in pngs["scaled_complexity"]  # an iTXt chunk, UTF-8
 
 
-def test_axis_labels_carry_the_thesis_symbols(svgs: dict[str, bytes]) -> None:
+def test_axis_labels_carry_the_thesis_symbols(
+    study: CompareReport, svgs: dict[str, bytes]
+) -> None:
     assert r"$\Gamma'$  scaled code size change" in svg_texts(svgs["scaled_changes"])
     assert r"$\Delta V_g'$  scaled complexity change" in svg_texts(svgs["scaled_complexity"])
     assert r"$E_{tot}$  complexity change cost" in svg_texts(svgs["cost_total"])
+    scoped = render_compare_chart(study, "cost_total", "svg", INTEGRATION)
+    assert r"$E_{B+F}$  complexity change cost" in svg_texts(scoped)
     coupling = svg_texts(svgs["coupling"])
     assert {r"$\Delta s_a$", r"$\Delta s_e$", r"$\Delta d_a$", r"$\Delta d_e$"} <= set(coupling)
 
@@ -262,7 +268,8 @@ def test_names_are_shown_as_typed_not_as_mathtext(study: CompareReport) -> None:
     renamed = CompareReport((("cost $x$ 1", study.series[0][1]), ("$", study.series[1][1])))
     texts = svg_texts(render_compare_chart(renamed, "cost_total", "svg"))
     assert texts[-2:] == ["cost $x$ 1", "$"]  # the legend: escaped, so drawn literally
-    assert "Complexity change cost across stages: cost $x$ 1, $" in texts
+    title = "Complexity change cost across stages, total of base, new and framework: cost $x$ 1, $"
+    assert title in texts
     assert decode_png(render_compare_chart(renamed, "scaled_changes")) is not None
 
 
@@ -306,3 +313,44 @@ def test_stages_named_otherwise_show_the_revision_they_measured(study: CompareRe
     assert chart.panels[0].groups == tuple(f"stage {i}\n({head})" for i, head in enumerate(heads))
     # stages named by their revisions (the study's tags) say it once
     assert chart_of(study, "cost").panels[0].groups == tuple(heads)
+
+
+def _scoped(base: Summary, framework: Summary, field: str) -> float | None:
+    """``field`` over base and framework together, from the two locations' summaries by the
+    thesis's equations: coupling and Γ add up; λ̂ and v̂g are ratios of the summed sizes
+    (6.16-6.18, 6.31); E = Γ'/ΔVg' (6.36), 0 when ΔVg' = 0 (6.38)."""
+    if field.startswith("delta_") and field != "delta_vg":
+        return float(getattr(base, field) + getattr(framework, field))
+    changes = base.changes + framework.changes
+    loc_pre, loc_post = base.loc_pre + framework.loc_pre, base.loc_post + framework.loc_post
+    vg_pre, vg_post = base.vg_pre + framework.vg_pre, base.vg_post + framework.vg_post
+    scaled = changes * (loc_post / loc_pre if loc_pre else 1.0)
+    delta_vg = (vg_post - vg_pre) * (vg_post / vg_pre if vg_pre else 1.0)
+    return {"scaled_changes": scaled, "scaled_delta_vg": delta_vg,
+            "cost": scaled / delta_vg if delta_vg else 0.0}[field]  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", [k for k in KINDS if k.endswith("_total")])
+def test_summary_charts_draw_base_plus_framework_when_asked_and_say_so(
+    study: CompareReport, kind: str
+) -> None:
+    scoped, total = chart_of(study, kind, INTEGRATION), chart_of(study, kind)
+    assert ", base + framework: " in scoped.title and "new" not in scoped.title
+    assert ", total of base, new and framework: " in total.title  # the thesis's total
+    fields = {
+        "coupling_total": [m.field for m in COUPLING_MEASURES],
+        "scaled_changes_total": ["scaled_changes"],
+        "scaled_complexity_total": ["scaled_delta_vg"],
+        "cost_total": ["cost"],
+    }[kind]
+    differs = False
+    for field, panel, whole in zip(fields, scoped.panels, total.panels, strict=True):
+        for (_, series), bars, all_bars in zip(study.series, panel.bars, whole.bars, strict=True):
+            for stage, value, all_value in zip(series.stages, bars.values, all_bars.values,
+                                               strict=True):  # fmt: skip
+                summaries = stage.report.summaries()
+                expected = _scoped(summaries["base"], summaries["framework"], field)
+                assert value.number == pytest.approx(expected), (kind, field, stage.label)
+                assert all_value.number == pytest.approx(getattr(summaries["total"], field))
+                differs |= value.number != all_value.number
+    assert differs  # the study's new location changes: the two scopes are not the same chart

@@ -18,6 +18,7 @@ from archmetrics.facts import (
     Binding,
     CallSite,
     Class,
+    ConfigTable,
     Decision,
     Deferred,
     Dependency,
@@ -112,6 +113,38 @@ def test_decoded_facts_share_repeated_arguments_and_texts_but_keep_literal_types
     values = [h.arguments[0].value for h in (h1, h2, h3)]
     assert values == [1, 1.0, True] and [type(v) for v in values] == [int, float, bool]
     assert first.statements[1].text is again.statements[1].text  # texts are interned
+
+
+CONFIG = FileFacts(
+    path="pragmatics/rules.toml",
+    language="toml",
+    tables=(
+        ConfigTable(("rules",), 2, (("name", ("drive",)),)),
+        ConfigTable(("rules", "to"), 4, (("kind", ("send",)), ("service", ("muri.backend",)))),
+    ),
+)
+
+
+def test_codec_round_trips_a_configuration_files_tables() -> None:
+    assert codec.decode(codec.encode(CONFIG), CONFIG.path) == CONFIG
+
+
+@pytest.mark.parametrize(
+    "edit",
+    [
+        lambda t: t[0].__setitem__(1, 0),  # a table on line 0
+        lambda t: t[0].__setitem__(1, "2"),  # a line that is text
+        lambda t: t[1][2][1][1].__setitem__(0, 7),  # a value that is a number
+        lambda t: t[1].__setitem__(0, ["rules", None]),  # a key that is no text
+        lambda t: t[1].pop(),  # a table of two parts
+    ],
+)
+def test_codec_rejects_tampered_configuration_tables(edit: Any) -> None:
+    head, *body = codec.encode(CONFIG).split(b"\n")
+    document = json.loads(head)
+    edit(document[-1])
+    with pytest.raises(codec.CodecError):
+        codec.decode(b"\n".join((json.dumps(document).encode(), *body)), CONFIG.path)
 
 
 def _parts() -> tuple[list[Any], bytes, bytes, bytes]:

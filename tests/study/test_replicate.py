@@ -132,6 +132,39 @@ def test_report_and_charts_are_written(study: Path) -> None:
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def _base_plus_framework_cost(report: Any, subject: str, approach: str, stage: str) -> float:
+    """E over base and framework together, from report.json's two location summaries by the
+    thesis's equations (λ̂, v̂g from the summed sizes; E = Γ'/ΔVg', 0 when ΔVg' = 0)."""
+    sides = [_total(report, subject, approach, stage, loc) for loc in ("base", "framework")]
+
+    def summed(field: str) -> int:
+        return sum(int(side[field]) for side in sides)
+
+    changes, loc_pre, loc_post = summed("changes"), summed("loc_pre"), summed("loc_post")
+    vg_pre, vg_post = summed("vg_pre"), summed("vg_post")
+    scaled = changes * (loc_post / loc_pre if loc_pre else 1.0)
+    delta_vg = (vg_post - vg_pre) * (vg_post / vg_pre if vg_pre else 1.0)
+    return scaled / delta_vg if delta_vg else 0.0
+
+
+def test_the_summary_charts_draw_the_findings_scope(study: Path, report: Any) -> None:
+    """The ``*_total`` charts add up base + framework (where the findings are judged), say so,
+    and show the values report.json's locations give for that scope."""
+    from tests.reports.test_charts import svg_texts
+
+    charts = study / "charts" / "idiomatic"
+    for kind in ("coupling_total", "scaled_changes_total", "scaled_complexity_total", "cost_total"):
+        texts = svg_texts((charts / f"pragmatics-{kind}.svg").read_bytes())
+        assert any(", base + framework: p2p, player, soa" in t for t in texts), kind
+        assert not any("new" in t for t in texts), kind  # the new location is not in them
+    texts = svg_texts((charts / "pragmatics-cost_total.svg").read_bytes())
+    labels = {t.rstrip("†‡§¶*#°") for t in texts}
+    for approach in ("soa", "player", "p2p"):
+        for stage in ("first", "second"):
+            expected = _base_plus_framework_cost(report, "pragmatics", approach, stage)
+            assert f"{expected:.2f}" in labels, (approach, stage, expected)
+
+
 def test_the_repositories_have_a_tag_per_stage(built: tuple[Path, Path]) -> None:
     repo = built[1] / "idiomatic" / "wdb" / "soa"
     done = subprocess.run(["git", "-C", str(repo), "tag"], capture_output=True, text=True)

@@ -1,0 +1,110 @@
+"""Validating a pack's ``[[configuration]]`` rules: which files are configuration, which of
+their tables are links. Every key is checked up front; errors name the file, rule and key."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+
+from archmetrics.coupling.patterns import PatternError, compile_pattern
+from archmetrics.coupling.rules import (
+    ENDPOINT_TYPES,
+    ConfigEndpoint,
+    ConfigRule,
+    LinkKind,
+    Role,
+    RulePackError,
+)
+from archmetrics.coupling.validate import Where
+from archmetrics.facts import ConfigFormat
+
+_KEYS = frozenset(
+    {"id", "files", "format", "table", "when", "defaults", "kind", "role", "endpoint",
+     "description", "example", "example_endpoint"}
+)  # fmt: skip
+_ENDPOINT_KEYS = frozenset({"type", "key", "pattern"})
+_FORMATS = frozenset(str(f) for f in ConfigFormat)
+_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
+_TABLE = re.compile(r"^[A-Za-z0-9_-]+(?:\.[A-Za-z0-9_-]+)*$")
+
+
+def parse_configuration(raw: object, pack: str, source: str) -> tuple[ConfigRule, ...]:
+    """The ``[[configuration]]`` array of a pack (absent: none)."""
+    if not isinstance(raw, list):
+        Where(source).fail("configuration", "must be an array of tables ([[configuration]])")
+    return tuple(_rule(item, pack, source, index) for index, item in enumerate(raw))
+
+
+def _rule(raw: object, pack: str, source: str, index: int) -> ConfigRule:
+    rule_id = raw.get("id") if isinstance(raw, Mapping) else None
+    where = Where(source, rule_id if isinstance(rule_id, str) else f"configuration #{index + 1}")
+    table = where.table(raw, "", _KEYS)
+    ident = where.text(table, "id")
+    if not _ID.match(ident):
+        where.fail("id", f"{ident!r} must be letters, digits and _.+-")
+    files = where.texts(table, "files", required=True)
+    for glob in files:
+        if glob.startswith("!") or not glob.strip("/"):
+            where.fail("files", f"{glob!r}: a glob may not be empty, '/' or a '!' negation")
+    selector = where.text(table, "table")
+    if not _TABLE.match(selector):
+        where.fail("table", f"{selector!r} must be bare keys joined by dots (rules.to)")
+    example_endpoint = table.get("example_endpoint")
+    if example_endpoint is not None and not isinstance(example_endpoint, str):
+        where.fail("example_endpoint", "must be a string")
+    return ConfigRule(
+        pack=pack,
+        id=ident,
+        files=files,
+        format=where.choice(table, "format", _FORMATS),
+        table=tuple(selector.split(".")),
+        kind=LinkKind(where.choice(table, "kind", frozenset(LinkKind))),
+        role=Role(where.choice(table, "role", frozenset(Role))),
+        endpoint=_endpoint(where, table.get("endpoint")),
+        when=_when(where, table.get("when", {})),
+        defaults=_defaults(where, table.get("defaults", {})),
+        description=where.text(table, "description", ""),
+        example=where.text(table, "example", ""),
+        example_endpoint=example_endpoint,
+    )
+
+
+def _endpoint(where: Where, raw: object) -> ConfigEndpoint:
+    table = where.table(raw, "endpoint", _ENDPOINT_KEYS)
+    try:
+        kind = where.choice(table, "type", ENDPOINT_TYPES)
+        key = where.text(table, "key")
+        pattern = where.text(table, "pattern", "") or None
+    except RulePackError as error:
+        key = f"endpoint.{error.key}"
+        raise RulePackError(error.source, error.rule, key, error.problem) from None
+    if pattern is not None:
+        try:
+            compile_pattern(pattern)
+        except PatternError as error:
+            where.fail("endpoint.pattern", f"bad regular expression: {error}")
+    return ConfigEndpoint(kind, key, pattern)
+
+
+def _when(where: Where, raw: object) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """``when = { kind = ["send", "request"] }``: each key's allowed values."""
+    if not isinstance(raw, Mapping):
+        where.fail("when", f"must be a table, got {type(raw).__name__}")
+    found = []
+    for key in raw:
+        try:
+            found.append((str(key), where.texts(raw, key, required=True)))
+        except RulePackError as error:
+            raise RulePackError(error.source, error.rule, f"when.{key}", error.problem) from None
+    return tuple(found)
+
+
+def _defaults(where: Where, raw: object) -> tuple[tuple[str, str], ...]:
+    """``defaults = { kind = "request" }``: what the configuration's reader assumes for a key
+    a table leaves out."""
+    if not isinstance(raw, Mapping):
+        where.fail("defaults", f"must be a table, got {type(raw).__name__}")
+    for key, value in raw.items():
+        if not isinstance(value, str):
+            where.fail(f"defaults.{key}", "must be a string")
+    return tuple((str(k), str(v)) for k, v in raw.items())
