@@ -28,6 +28,7 @@ from collections.abc import Iterable, Mapping
 
 from archmetrics.changeset.cost import Sums, location_summary, total_summary
 from archmetrics.changeset.elements import (
+    CouplingValues,
     Differ,
     ElementLike,
     Side,
@@ -45,7 +46,8 @@ from archmetrics.changeset.model import (
     FilePair,
     Metrics,
 )
-from archmetrics.changeset.statement_diff import diff_files
+from archmetrics.changeset.rows import diff_measured
+from archmetrics.changeset.unchanged import Unchanged, unchanged_change
 from archmetrics.coupling.elements import group_elements
 from archmetrics.coupling.model import CouplingReport
 
@@ -57,16 +59,17 @@ def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
 
 def _sums(elements: Iterable[ElementChange]) -> Sums:
     """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31)."""
-    pre, post, added, removed, modified = Metrics(), Metrics(), 0, 0, 0
+    pre, post = [0] * 7, [0] * 7
+    added = removed = modified = 0
     for element in elements:
-        pre = pre + (element.pre or Metrics())
-        post = post + (element.post or Metrics())
-        added, removed, modified = (
-            added + element.added,
-            removed + element.removed,
-            modified + element.modified,
-        )
-    return Sums(pre, post, added, removed, modified)
+        for total, metrics in ((pre, element.pre), (post, element.post)):
+            if metrics is not None:
+                for i, value in enumerate(metrics.as_tuple()):
+                    total[i] += value
+        added += element.added
+        removed += element.removed
+        modified += element.modified
+    return Sums(Metrics(*pre), Metrics(*post), added, removed, modified)
 
 
 def side_notes(sides: tuple[Side, Side]) -> list[str]:
@@ -86,26 +89,40 @@ def compute_change(
     pairs: Iterable[FilePair],
     elements: Iterable[ElementLike] | None,
     rules: LocationRules,
-    coupling_pre: Mapping[str, Coupling] | None,
-    coupling_post: Mapping[str, Coupling] | None,
+    coupling_pre: Mapping[str, CouplingValues] | None,
+    coupling_post: Mapping[str, CouplingValues] | None,
     *,
     dynamic_pre_zero: bool = False,
-    diff: Differ = diff_files,
+    diff: Differ = diff_measured,
+    unchanged: Unchanged | None = None,
 ) -> ChangeReport:
-    """Chapter 6 metrics of one comparison: per location, total, per element, exclusions."""
+    """Chapter 6 metrics of one comparison: per location, total, per element, exclusions.
+
+    ``unchanged``: elements none of whose files changed, reported from their rows; their
+    pairs are then left out of ``pairs`` (a diff of two trees that share most files pairs
+    only the files of the elements that hold a changed one)."""
     kept, excluded = measured_pairs(pairs, rules)
     if elements is None:
         paths = {f.path for p in kept for f in (p.pre, p.post) if f is not None}
         elements = group_elements(paths)
     groups = assign(kept, element_index(elements))
+    rows = unchanged.elements if unchanged else {}
+    if rows.keys() & groups.keys():
+        raise ValueError("an element is both unchanged and paired")
     sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
     changes: list[ElementChange] = []
     notes: list[tuple[Location, str]] = []
-    for name in sorted(groups):
+    for name in sorted(groups.keys() | rows.keys()):
         element_notes: list[str] = []
-        change = element_change(name, groups[name], rules, sides, element_notes, diff)
+        row = rows.get(name)
+        if row is not None:
+            change = unchanged_change(name, row, sides, element_notes)
+        else:
+            change = element_change(name, groups[name], rules, sides, element_notes, diff)
         changes.append(change)
         notes += [(change.location, n) for n in element_notes]
+    if unchanged and unchanged.excluded:
+        excluded = sorted([*excluded, *unchanged.excluded], key=lambda x: (x.path, x.reason))
     return report_of(changes, excluded, side_notes(sides), notes)
 
 

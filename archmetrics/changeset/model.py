@@ -10,11 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 from archmetrics.changeset.locations import Location
 from archmetrics.changeset.statement_diff import FileChange
-from archmetrics.facts import FileFacts
 
 JsonValue = int | float | str | None | list["JsonValue"] | dict[str, "JsonValue"]
 
@@ -61,12 +60,38 @@ class Status(StrEnum):
     UNCHANGED = "unchanged"  # it existed on both sides and Γ = 0
 
 
+class MeasuredFile(Protocol):
+    """What a comparison reads of a file besides its statements: a file's facts, or its row
+    when it is not diffed (changeset/rows.py)."""
+
+    @property
+    def path(self) -> str: ...
+
+    @property
+    def language(self) -> str: ...
+
+    @property
+    def loc(self) -> int: ...
+
+    @property
+    def sloc(self) -> int: ...
+
+    @property
+    def vg(self) -> int: ...
+
+    @property
+    def parsed(self) -> bool: ...
+
+    @property
+    def generated(self) -> bool: ...
+
+
 @dataclass(frozen=True, slots=True)
 class FilePair:
     """One file across the two revisions (the caller pairs them, following git renames)."""
 
-    pre: FileFacts | None
-    post: FileFacts | None
+    pre: MeasuredFile | None
+    post: MeasuredFile | None
 
     def __post_init__(self) -> None:
         if self.pre is None and self.post is None:
