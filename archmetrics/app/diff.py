@@ -5,7 +5,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
@@ -14,11 +14,14 @@ from typing import TypeVar
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import configuration_files, coupling_options, rule_set
 from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.app.tree import Side, begin_delta, side_of
 from archmetrics.app.workers import WorkerLimits
-from archmetrics.changeset import ChangeReport, Coupling, LocationRules, compute_change
+from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
-from archmetrics.changeset.files import measured_files, pair_files
+from archmetrics.changeset.files import exclusion, pair_files
 from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.changeset.model import MeasuredFile
+from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
     CHANGE_RECORD,
     FileChange,
@@ -27,8 +30,9 @@ from archmetrics.changeset.statement_diff import (
     diff_files,
     same_statements,
 )
+from archmetrics.changeset.unchanged import Unchanged
 from archmetrics.config import Settings
-from archmetrics.coupling import CouplingOptions, group_elements, measure_coupling
+from archmetrics.coupling import CouplingOptions, group_elements
 from archmetrics.coupling.rules import RuleSet
 from archmetrics.coupling.sitememo import RECORD, SiteMemo
 from archmetrics.facts import FileFacts, ParseWarning
@@ -105,35 +109,6 @@ def location_rules(request: DiffRequest) -> LocationRules:
     )
 
 
-def coupling_values(
-    files: Sequence[FileFacts],
-    rules: LocationRules,
-    options: CouplingOptions,
-    packs: RuleSet,
-    cache: FactsCache | None = None,
-    blobs: Mapping[str, str] | None = None,
-) -> dict[str, Coupling]:
-    """Element name -> (s_a, s_e, d_a, d_e) over the measured (not excluded) files of a tree.
-
-    With a ``cache`` and the files' ``blobs``, the result is kept under a digest of all that
-    decides it (:func:`coupling_key`) and read back when the same tree is measured again."""
-    measured = measured_files(files, rules)
-    key = (
-        None
-        if cache is None or blobs is None
-        else coupling_key(measured, blobs, options, packs, cache.fingerprint)
-    )
-
-    def compute() -> dict[str, Coupling]:
-        memo = None
-        if cache is not None and blobs is not None:
-            memo = site_memo(cache, measured, blobs, options, packs)
-        report = measure_coupling(measured, options, packs, memo)
-        return {c.element.name: Coupling(c.s_a, c.s_e, c.d_a, c.d_e) for c in report.elements}
-
-    return _kept(cache, key, _read_coupling, compute, _compact)
-
-
 class _CachedSites:
     """The facts cache as a store of link-site records (coupling/sitememo.py)."""
 
@@ -149,17 +124,42 @@ class _CachedSites:
 
 def site_memo(
     cache: FactsCache,
-    measured: Sequence[FileFacts],
+    measured: Sequence[MeasuredFile] | Mapping[str, FileRow],
     blobs: Mapping[str, str],
     options: CouplingOptions,
     packs: RuleSet,
 ) -> SiteMemo:
     """Each file's link sites kept in ``cache`` by content: a tree coupled after another that
     shares most of its files (the worktree after an edit, the next revision of a series)
-    matches rules and traces endpoints only for the files whose reach changed."""
+    matches rules and traces endpoints only for the files whose reach changed. ``measured``:
+    the measured files, or rows by path (each file's content then named when asked for:
+    a patch asks for the few files it redoes)."""
     context = _digest([RECORD, code_fingerprint(), cache.fingerprint, repr(options), repr(packs)])
-    identity = {f.path: f"{blobs[f.path]}:{f.language}" for f in measured if blobs.get(f.path)}
+    identity: Mapping[str, str]
+    if isinstance(measured, Mapping):
+        identity = _Contents(measured)
+    else:
+        identity = {f.path: f"{blobs[f.path]}:{f.language}" for f in measured if blobs.get(f.path)}
     return SiteMemo(_CachedSites(cache), context, identity)
+
+
+class _Contents(Mapping[str, str]):
+    """Each file's content id (blob and language), made from its row when asked for."""
+
+    def __init__(self, rows: Mapping[str, FileRow]) -> None:
+        self.rows = rows
+
+    def __getitem__(self, path: str) -> str:
+        row = self.rows[path]
+        if not row.blob:
+            raise KeyError(path)
+        return f"{row.blob}:{row.language}"
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.rows)
+
+    def __len__(self) -> int:
+        return len(self.rows)
 
 
 _T = TypeVar("_T")
@@ -196,58 +196,20 @@ def _digest(document: Sequence[object]) -> str:
     return hashlib.sha256(json.dumps(document).encode()).hexdigest()
 
 
-def coupling_key(
-    measured: Sequence[FileFacts],
-    blobs: Mapping[str, str],
-    options: CouplingOptions,
-    packs: RuleSet,
-    parser: str,
-) -> str | None:
-    """A digest of what decides a tree's coupling: this archmetrics's code, the facts (each
-    file's path, blob and language, in order, under the ``parser`` fingerprint of the facts
-    cache, which holds the parser settings), the coupling options and the rule packs as
-    loaded. None if a file's blob is unknown."""
-    files = []
-    for facts in measured:
-        blob = blobs.get(facts.path)
-        if not blob:
-            return None
-        files.append((facts.path, blob, facts.language))
-    return _digest(["coupling/1", code_fingerprint(), parser, repr(options), repr(packs), files])
-
-
-def _read_coupling(data: bytes) -> dict[str, Coupling] | None:
-    """Coupling values as ``coupling_values`` stored them, or None if ``data`` is anything
-    else (the cache file is not trusted: a bad entry is recomputed, never believed)."""
-    try:
-        document = json.loads(data)
-    except ValueError:
-        return None
-    if not isinstance(document, dict):
-        return None
-    values: dict[str, Coupling] = {}
-    for name, numbers in document.items():
-        if not (
-            isinstance(numbers, list)
-            and len(numbers) == 4
-            and all(type(n) is int and n >= 0 for n in numbers)
-        ):
-            return None
-        values[name] = Coupling(*numbers)
-    return values
-
-
 def cached_differ(
-    cache: FactsCache, pre_blobs: Mapping[str, str], post_blobs: Mapping[str, str]
+    cache: FactsCache, pre: Mapping[str, FileRow], post: Mapping[str, FileRow]
 ) -> Differ:
-    """``diff_files`` with each file pair's change kept in ``cache`` under a digest of what
-    decides it (:func:`change_key`): a diff that meets the same two blobs again (the next
-    diff of a branch, a warm rerun, each stage of a series) reads neither file's statements."""
+    """``diff_measured`` with each file pair's change kept in ``cache`` under a digest of
+    what decides it (:func:`change_key`): a diff that meets the same two blobs again (the
+    next diff of a branch, a warm rerun, each stage of a series) reads neither file's
+    statements. ``pre``, ``post``: each side's rows by path (their blobs)."""
 
-    def diff(pre: FileFacts | None, post: FileFacts | None) -> FileChange:
-        if pre and post and same_statements(pre.statements, post.statements):
-            return diff_files(pre, post)  # known equal without reading them: nothing to keep
-        pre_path, post_path = pre.path if pre else None, post.path if post else None
+    def diff(before: MeasuredFile | None, after: MeasuredFile | None) -> FileChange:
+        if not isinstance(before, FileFacts | None) or not isinstance(after, FileFacts | None):
+            return diff_measured(before, after)  # rows of one content: nothing to keep
+        if before and after and same_statements(before.statements, after.statements):
+            return diff_files(before, after)  # known equal without reading them
+        pre_path, post_path = before.path if before else None, after.path if after else None
 
         def read(data: bytes) -> FileChange | None:
             try:
@@ -255,12 +217,12 @@ def cached_differ(
             except ValueError:
                 return None
 
-        key = change_key(pre, post, pre_blobs, post_blobs, cache.fingerprint)
+        key = change_key(before, after, pre, post, cache.fingerprint)
         return _kept(
             cache,
             key,
             read,
-            lambda: diff_files(pre, post),
+            lambda: diff_files(before, after),
             lambda change: _compact(change_record(change)),
         )
 
@@ -270,8 +232,8 @@ def cached_differ(
 def change_key(
     pre: FileFacts | None,
     post: FileFacts | None,
-    pre_blobs: Mapping[str, str],
-    post_blobs: Mapping[str, str],
+    pre_rows: Mapping[str, FileRow],
+    post_rows: Mapping[str, FileRow],
     parser: str,
 ) -> str | None:
     """A digest of what decides a file pair's change: this archmetrics's code (the pairing
@@ -279,20 +241,20 @@ def change_key(
     ``parser`` fingerprint of the facts cache, named by the record's kind (the cache's
     ``totals`` table holds trees' coupling too). None if a side's blob is unknown."""
     sides: list[object] = []
-    for facts, blobs in ((pre, pre_blobs), (post, post_blobs)):
+    for facts, rows in ((pre, pre_rows), (post, post_rows)):
         if facts is None:
             sides.append(None)
             continue
-        blob = blobs.get(facts.path)
-        if not blob:
+        row = rows.get(facts.path)
+        if row is None or not row.blob:
             return None
-        sides.append([blob, facts.language])
+        sides.append([row.blob, facts.language])
     document = [CHANGE_RECORD, code_fingerprint(), _rapidfuzz(), parser, sides]
     return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
 def parse_warnings(
-    *sides: Sequence[FileFacts], rules: LocationRules | None = None
+    *sides: Sequence[FileFacts | FileRow], rules: LocationRules | None = None
 ) -> tuple[ParseWarning, ...]:
     """Every distinct parse warning of the files of each side, in order; none of a file an
     exclude glob of ``rules`` leaves out (it is listed as excluded, as a scan lists it)."""
@@ -337,45 +299,123 @@ def measure_change(
     checkout = checkout or open_checkout(request.root)
     options = options or diff_options(request, checkout.root)
     snapshots = (checkout.snapshot(request.base), checkout.snapshot(request.head))
-    renames = checkout.renames(request.base, request.head)
+    opened = checkout
+
+    def renames() -> Mapping[str, str]:
+        return opened.renames(request.base, request.head)
+
     return measure_snapshots(options, snapshots, renames, progress, cache)
 
 
 def measure_snapshots(
     options: DiffOptions,
     snapshots: tuple[Snapshot, Snapshot],
-    renames: Mapping[str, str],
+    renames: Mapping[str, str] | Callable[[], Mapping[str, str]],
     progress: Progress | None = None,
     cache: FactsCache | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
-    path), under ``options``."""
+    path, or how to ask for them when the head's state was not patched from the base's),
+    under ``options``. Each side's state comes from app/tree.py: kept, patched or built."""
     progress = progress or NoProgress()
     base, head = snapshots
-    rules = options.rules
-    pre_blobs: dict[str, str] = {}
-    post_blobs: dict[str, str] = {}
-    pre = parse_side(base, options, progress, cache, pre_blobs)
-    progress.phase(f"reading {head.label}")
-    post = parse_side(head, options, progress, cache, post_blobs)
-    coupling, packs = options.coupling, options.packs
-    progress.phase(f"coupling {base.label}")
-    pre_coupling = coupling_values(pre, rules, coupling, packs, cache, pre_blobs)
-    progress.phase(f"coupling {head.label}")
-    post_coupling = coupling_values(post, rules, coupling, packs, cache, post_blobs)
+    delta = begin_delta(base, head, cache)  # git walks the head tree while the base is read
+    try:
+        pre = side_of(base, options, cache, progress)
+        progress.phase(f"reading {head.label}")
+        post = side_of(head, options, cache, progress, origin=pre, delta=delta)
+    finally:
+        if delta is not None:
+            delta.cancel()  # its git processes, if the head's state did not need them
+    if post.renames is not None:
+        moved: Mapping[str, str] = post.renames
+    else:
+        moved = renames() if callable(renames) else renames
     progress.phase("comparing the changed files")
-    paths = {f.path for f in (*pre, *post)}
-    change = compute_change(
-        pair_files(pre, post, renames),
-        group_elements(paths, coupling.per_file),
-        rules,
-        pre_coupling,
-        post_coupling,
-        dynamic_pre_zero=options.dynamic_pre_zero,
-        diff=diff_files if cache is None else cached_differ(cache, pre_blobs, post_blobs),
-    )
+    change = _compare(pre, post, moved, options, progress, cache)
     progress.stop()
-    return change, parse_warnings(pre, post, rules=rules)
+    return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
+
+
+def _compare(
+    pre: Side,
+    post: Side,
+    renames: Mapping[str, str],
+    options: DiffOptions,
+    progress: Progress,
+    cache: FactsCache | None,
+) -> ChangeReport:
+    """The change between the two sides. Where both group their files alike (the same
+    paths), only the elements holding a file that differs are paired and diffed; the
+    others are reported from the base side's element rows (changeset/unchanged.py)."""
+    differ = diff_measured if cache is None else cached_differ(cache, pre.by_path, post.by_path)
+    values = (pre.state.index.values, post.state.index.values)
+    same = pre.state.groups is post.state.groups or pre.state.groups == post.state.groups
+    if not same:
+        pairs = pair_files(pre.state.rows, post.state.rows, renames)
+        paths = {row.path for row in (*pre.state.rows, *post.state.rows)}
+        elements = group_elements(paths, options.coupling.per_file)
+        return compute_change(
+            _with_facts(pairs, pre, post, options, progress), elements, options.rules,
+            values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
+        )  # fmt: skip
+    changed = post.changed if post.changed is not None else _differing(pre, post)
+    owner = pre.owner
+    touched = {owner[path] for path in changed if path in owner}
+    touched_elements = [e for e in pre.state.groups if e.name in touched]
+    pairs = [FilePair(pre.by_path[p], post.by_path[p]) for e in touched_elements for p in e.files]
+    unchanged = Unchanged(
+        {name: row for name, row in pre.state.table.items() if name not in touched},
+        tuple(x for x in pre.state.excluded if owner.get(x.path) not in touched),
+    )
+    return compute_change(
+        _with_facts(pairs, pre, post, options, progress), touched_elements, options.rules,
+        values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
+        unchanged=unchanged,
+    )  # fmt: skip
+
+
+def _differing(pre: Side, post: Side) -> frozenset[str]:
+    """The paths (the same on both sides) whose files differ in content or language."""
+    return frozenset(
+        a.path
+        for a, b in zip(pre.state.rows, post.state.rows, strict=True)
+        if (a.blob, a.language) != (b.blob, b.language)
+    )
+
+
+def _with_facts(
+    pairs: list[FilePair], pre: Side, post: Side, options: DiffOptions, progress: Progress
+) -> list[FilePair]:
+    """``pairs`` of rows, those of files that differ given the facts of each side that can
+    be measured (so that they are diffed); pairs of one content stay rows."""
+    wanted: tuple[set[str], set[str]] = (set(), set())
+    for pair in pairs:
+        sides = (pair.pre, pair.post)
+        if _same(*sides) or not all(row.parsed for row in sides if row):
+            continue  # rows of one content, or a pair dropped whole (not_parsed)
+        for row, paths in zip(sides, wanted, strict=True):
+            if isinstance(row, FileRow) and exclusion(row, options.rules) is None:
+                paths.add(row.path)
+    found = (
+        pre.facts_of(wanted[0], options, progress),
+        post.facts_of(wanted[1], options, progress),
+    )
+    return [
+        pair if _same(pair.pre, pair.post) else FilePair(
+            found[0].get(pair.pre.path, pair.pre) if pair.pre else None,
+            found[1].get(pair.post.path, pair.post) if pair.post else None,
+        )
+        for pair in pairs
+    ]  # fmt: skip
+
+
+def _same(pre: MeasuredFile | None, post: MeasuredFile | None) -> bool:
+    return (
+        isinstance(pre, FileRow)
+        and isinstance(post, FileRow)
+        and (pre.blob, pre.language) == (post.blob, post.language)
+    )
 
 
 def run_diff(

@@ -24,10 +24,11 @@ or not; sums run over all elements of a location, changed or not (docs/metrics.m
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 
 from archmetrics.changeset.cost import Sums, location_summary, total_summary
 from archmetrics.changeset.elements import (
+    CouplingValues,
     Differ,
     ElementLike,
     Side,
@@ -45,7 +46,8 @@ from archmetrics.changeset.model import (
     FilePair,
     Metrics,
 )
-from archmetrics.changeset.statement_diff import diff_files
+from archmetrics.changeset.rows import diff_measured
+from archmetrics.changeset.unchanged import Unchanged, unchanged_change
 from archmetrics.coupling.elements import group_elements
 from archmetrics.coupling.model import CouplingReport
 
@@ -55,18 +57,17 @@ def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
     return {e.element.name: Coupling(e.s_a, e.s_e, e.d_a, e.d_e) for e in report.elements}
 
 
-def _sums(elements: Iterable[ElementChange]) -> Sums:
+def _sums(elements: Sequence[ElementChange]) -> Sums:
     """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31)."""
-    pre, post, added, removed, modified = Metrics(), Metrics(), 0, 0, 0
-    for element in elements:
-        pre = pre + (element.pre or Metrics())
-        post = post + (element.post or Metrics())
-        added, removed, modified = (
-            added + element.added,
-            removed + element.removed,
-            modified + element.modified,
-        )
-    return Sums(pre, post, added, removed, modified)
+    pre = [e.pre for e in elements if e.pre is not None]
+    post = [e.post for e in elements if e.post is not None]
+    return Sums(
+        Metrics(*map(sum, zip(*pre, strict=True))) if pre else Metrics(),
+        Metrics(*map(sum, zip(*post, strict=True))) if post else Metrics(),
+        sum(e.added for e in elements),
+        sum(e.removed for e in elements),
+        sum(e.modified for e in elements),
+    )
 
 
 def side_notes(sides: tuple[Side, Side]) -> list[str]:
@@ -86,26 +87,40 @@ def compute_change(
     pairs: Iterable[FilePair],
     elements: Iterable[ElementLike] | None,
     rules: LocationRules,
-    coupling_pre: Mapping[str, Coupling] | None,
-    coupling_post: Mapping[str, Coupling] | None,
+    coupling_pre: Mapping[str, CouplingValues] | None,
+    coupling_post: Mapping[str, CouplingValues] | None,
     *,
     dynamic_pre_zero: bool = False,
-    diff: Differ = diff_files,
+    diff: Differ = diff_measured,
+    unchanged: Unchanged | None = None,
 ) -> ChangeReport:
-    """Chapter 6 metrics of one comparison: per location, total, per element, exclusions."""
+    """Chapter 6 metrics of one comparison: per location, total, per element, exclusions.
+
+    ``unchanged``: elements none of whose files changed, reported from their rows; their
+    pairs are then left out of ``pairs`` (a diff of two trees that share most files pairs
+    only the files of the elements that hold a changed one)."""
     kept, excluded = measured_pairs(pairs, rules)
     if elements is None:
         paths = {f.path for p in kept for f in (p.pre, p.post) if f is not None}
         elements = group_elements(paths)
     groups = assign(kept, element_index(elements))
+    rows = unchanged.elements if unchanged else {}
+    if rows.keys() & groups.keys():
+        raise ValueError("an element is both unchanged and paired")
     sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
     changes: list[ElementChange] = []
     notes: list[tuple[Location, str]] = []
-    for name in sorted(groups):
+    for name in sorted(groups.keys() | rows.keys()):
         element_notes: list[str] = []
-        change = element_change(name, groups[name], rules, sides, element_notes, diff)
+        row = rows.get(name)
+        if row is not None:
+            change = unchanged_change(name, row, sides, element_notes)
+        else:
+            change = element_change(name, groups[name], rules, sides, element_notes, diff)
         changes.append(change)
         notes += [(change.location, n) for n in element_notes]
+    if unchanged and unchanged.excluded:
+        excluded = sorted([*excluded, *unchanged.excluded], key=lambda x: (x.path, x.reason))
     return report_of(changes, excluded, side_notes(sides), notes)
 
 
@@ -124,13 +139,11 @@ def report_of(
     by_location: dict[Location, list[str]] = {loc: [] for loc in Location}
     for location, note in notes:
         by_location[location].append(note)
+    located: dict[Location, list[ElementChange]] = {loc: [] for loc in Location}
+    for change in changes:
+        located[change.location].append(change)
     summaries = tuple(
-        (
-            loc,
-            location_summary(
-                _sums(c for c in changes if c.location is loc), (*common, *by_location[loc])
-            ),
-        )
+        (loc, location_summary(_sums(located[loc]), (*common, *by_location[loc])))
         for loc in Location
     )
     all_notes = [*common, *(n for loc in Location for n in by_location[loc])]

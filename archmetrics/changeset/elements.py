@@ -13,13 +13,22 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from archmetrics.changeset.locations import Location, LocationRules
-from archmetrics.changeset.model import Coupling, ElementChange, FilePair, Metrics, Status
-from archmetrics.changeset.statement_diff import FileChange, diff_files
+from archmetrics.changeset.model import (
+    ElementChange,
+    FilePair,
+    MeasuredFile,
+    Metrics,
+    Status,
+)
+from archmetrics.changeset.rows import diff_measured
+from archmetrics.changeset.statement_diff import FileChange
 from archmetrics.facts import FileFacts
 
-# How a file pair's change is found: diff_files, or a function that gives what it would
+CouplingValues = tuple[int, int, int, int]
+
+# How a file pair's change is found: diff_measured, or a function that gives what it would
 # give (the application's, which keeps changes in the cache by the files' blobs)
-Differ = Callable[[FileFacts | None, FileFacts | None], FileChange]
+Differ = Callable[[MeasuredFile | None, MeasuredFile | None], FileChange]
 
 
 class ElementLike(Protocol):
@@ -37,7 +46,7 @@ class Side:
     """One revision's coupling values; ``values`` None means coupling was not measured."""
 
     label: str  # "pre" or "post"
-    values: Mapping[str, Coupling] | None
+    values: Mapping[str, CouplingValues] | None  # s_a, s_e, d_a, d_e (a Coupling or a tuple)
     dynamic_zero: bool = False  # the thesis convention (p. 100): d_a = d_e = 0 before
 
 
@@ -65,12 +74,23 @@ def assign(pairs: Iterable[FilePair], index: Mapping[str, str]) -> dict[str, lis
 
 
 def _metrics(
-    element: str, files: Sequence[FileFacts], side: Side, notes: list[str]
+    element: str, files: Sequence[MeasuredFile], side: Side, notes: list[str]
 ) -> Metrics | None:
     """M of one side: λ, SLOC, v_g summed over the files, coupling from the coupling layer."""
     if not files:
         return None
-    coupling = Coupling()
+    loc = sum(f.loc for f in files)
+    sloc = sum(f.sloc for f in files)
+    vg = sum(f.vg for f in files)
+    return side_metrics(element, loc, sloc, vg, side, notes)
+
+
+def side_metrics(
+    element: str, loc: int, sloc: int, vg: int, side: Side, notes: list[str]
+) -> Metrics:
+    """M of one side of an element with these sums, coupling from the coupling layer (a
+    missing value is 0 and noted; d_a, d_e are 0 before under the thesis convention)."""
+    s_a = s_e = d_a = d_e = 0
     if side.values is not None:
         found = side.values.get(element)
         if found is None:
@@ -78,21 +98,14 @@ def _metrics(
                 f"coupling_missing_{side.label}: element {element!r} has no {side.label}"
                 " coupling values; taken as 0"
             )
-        coupling = found or coupling
+        else:
+            s_a, s_e, d_a, d_e = found
     if side.dynamic_zero:
-        coupling = coupling._replace(d_a=0, d_e=0)
-    return Metrics(
-        loc=sum(f.loc for f in files),
-        sloc=sum(f.sloc for f in files),
-        vg=sum(f.vg for f in files),
-        s_a=coupling.s_a,
-        s_e=coupling.s_e,
-        d_a=coupling.d_a,
-        d_e=coupling.d_e,
-    )
+        d_a = d_e = 0
+    return Metrics(loc, sloc, vg, s_a, s_e, d_a, d_e)
 
 
-def _location(
+def file_location(
     element: str, pairs: Sequence[FilePair], rules: LocationRules, notes: list[str]
 ) -> Location:
     """Where most of the element's files are (ties: its first file's); mixed ones are flagged."""
@@ -118,7 +131,13 @@ def _status(pre: Metrics | None, post: Metrics | None, changes: int) -> Status:
 
 def _reconfigured(pairs: Sequence[FilePair]) -> int:
     """How many of the files changed their configuration tables (facts.ConfigTable)."""
-    return sum(1 for p in pairs if p.pre and p.post and p.pre.tables != p.post.tables)
+    return sum(
+        1
+        for p in pairs
+        if isinstance(p.pre, FileFacts)  # a row stands for a file that did not change
+        and isinstance(p.post, FileFacts)
+        and p.pre.tables != p.post.tables
+    )
 
 
 def element_change(
@@ -127,10 +146,12 @@ def element_change(
     rules: LocationRules,
     sides: tuple[Side, Side],
     notes: list[str],
-    diff: Differ = diff_files,
+    diff: Differ = diff_measured,
 ) -> ElementChange:
     """The change set of one element: statement diffs of its files, status, M before and after."""
-    file_changes = tuple(diff(p.pre, p.post) for p in sorted(pairs, key=lambda p: p.path))
+    found = [diff(p.pre, p.post) for p in sorted(pairs, key=lambda p: p.path)]
+    # the detail of the files that changed (a file unchanged has none to give)
+    file_changes = tuple(c for c in found if c.total or c.approximate)
     for change in file_changes:
         if change.approximate:
             notes.append(
@@ -144,7 +165,7 @@ def element_change(
     modified = sum(c.modified for c in file_changes)
     return ElementChange(
         element=element,
-        location=_location(element, pairs, rules, notes),
+        location=file_location(element, pairs, rules, notes),
         files=tuple(sorted(p.path for p in pairs)),
         # a configuration file has no statements: a change of its tables is its change
         status=_status(pre, post, added + removed + modified + _reconfigured(pairs)),

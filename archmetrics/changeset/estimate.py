@@ -10,7 +10,6 @@ E and the coupling deltas use one set of formulas (cost.py). Choices the thesis 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import replace
 
 from archmetrics.changeset.compute import report_of, side_notes
 from archmetrics.changeset.elements import Side
@@ -122,7 +121,7 @@ def _element(
     )
     changes = gained.added + gained.removed + gained.modified
     status = Status.ADDED if pre is None else Status.MODIFIED if changes else Status.UNCHANGED
-    shown_pre = replace(pre, d_a=0, d_e=0) if pre and dynamic_pre_zero else pre
+    shown_pre = pre._replace(d_a=0, d_e=0) if pre and dynamic_pre_zero else pre
     files = before.files if before else ()
     change = ElementChange(
         name,

@@ -8,26 +8,28 @@ or it is generated and generated files are left out (docs/metrics.md, "Exclusion
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
+from typing import TypeVar
 
 from archmetrics.changeset.locations import LocationRules
-from archmetrics.changeset.model import ExcludedFile, FilePair
-from archmetrics.facts import FileFacts
+from archmetrics.changeset.model import ExcludedFile, FilePair, MeasuredFile
+
+_F = TypeVar("_F", bound=MeasuredFile)
 
 
-def exclusion(facts: FileFacts, rules: LocationRules) -> str | None:
+def exclusion(facts: MeasuredFile, rules: LocationRules) -> str | None:
     """Why a readable file counts nowhere (its path's exclude glob, or ``generated``), or None."""
     if reason := rules.is_excluded(facts.path):
         return reason
     return "generated" if rules.exclude_generated and facts.generated else None
 
 
-def measured_files(files: Iterable[FileFacts], rules: LocationRules) -> list[FileFacts]:
+def measured_files(files: Iterable[_F], rules: LocationRules) -> list[_F]:
     """The files of one tree that are measured: read by a parser and not excluded."""
     return [f for f in files if f.parsed and exclusion(f, rules) is None]
 
 
 def pair_files(
-    pre: Sequence[FileFacts], post: Sequence[FileFacts], renames: Mapping[str, str]
+    pre: Sequence[MeasuredFile], post: Sequence[MeasuredFile], renames: Mapping[str, str]
 ) -> list[FilePair]:
     """Files paired across the revisions by path, and by git's renames (old -> new)."""
     after = {f.path: f for f in post}

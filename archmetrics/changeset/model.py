@@ -10,11 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 from archmetrics.changeset.locations import Location
 from archmetrics.changeset.statement_diff import FileChange
-from archmetrics.facts import FileFacts
 
 JsonValue = int | float | str | None | list["JsonValue"] | dict[str, "JsonValue"]
 
@@ -28,9 +27,11 @@ class Coupling(NamedTuple):
     d_e: int = 0
 
 
-@dataclass(frozen=True, slots=True)
-class Metrics:
-    """M: an element's (or a location's summed) size, complexity and coupling in one revision."""
+class Metrics(NamedTuple):
+    """M: an element's (or a location's summed) size, complexity and coupling in one revision.
+
+    A named tuple (a diff makes two per element, 56,000 for a tree of 28,000 elements);
+    ``+`` adds field by field, as the sums of eqs. 6.2-6.31 do."""
 
     loc: int = 0  # λ, logical lines of code (thesis p. 103)
     sloc: int = 0  # physical non-blank, non-comment lines (informative; not in any equation)
@@ -40,16 +41,17 @@ class Metrics:
     d_a: int = 0
     d_e: int = 0
 
-    def __add__(self, other: Metrics) -> Metrics:
-        return Metrics(*(a + b for a, b in zip(self.as_tuple(), other.as_tuple(), strict=True)))
+    def __add__(self, other: tuple[int, ...]) -> Metrics:  # type: ignore[override]
+        return Metrics(*(a + b for a, b in zip(self, other, strict=True)))
 
     def as_tuple(self) -> tuple[int, int, int, int, int, int, int]:
         return (self.loc, self.sloc, self.vg, self.s_a, self.s_e, self.d_a, self.d_e)
 
     def to_dict(self) -> dict[str, JsonValue]:
-        return dict(
-            zip(("loc", "sloc", "vg", "s_a", "s_e", "d_a", "d_e"), self.as_tuple(), strict=True)
-        )
+        return dict(zip(_METRIC_FIELDS, self, strict=True))
+
+
+_METRIC_FIELDS = Metrics._fields
 
 
 class Status(StrEnum):
@@ -61,12 +63,38 @@ class Status(StrEnum):
     UNCHANGED = "unchanged"  # it existed on both sides and Γ = 0
 
 
+class MeasuredFile(Protocol):
+    """What a comparison reads of a file besides its statements: a file's facts, or its row
+    when it is not diffed (changeset/rows.py)."""
+
+    @property
+    def path(self) -> str: ...
+
+    @property
+    def language(self) -> str: ...
+
+    @property
+    def loc(self) -> int: ...
+
+    @property
+    def sloc(self) -> int: ...
+
+    @property
+    def vg(self) -> int: ...
+
+    @property
+    def parsed(self) -> bool: ...
+
+    @property
+    def generated(self) -> bool: ...
+
+
 @dataclass(frozen=True, slots=True)
 class FilePair:
     """One file across the two revisions (the caller pairs them, following git renames)."""
 
-    pre: FileFacts | None
-    post: FileFacts | None
+    pre: MeasuredFile | None
+    post: MeasuredFile | None
 
     def __post_init__(self) -> None:
         if self.pre is None and self.post is None:
@@ -80,9 +108,9 @@ class FilePair:
         return side.path
 
 
-@dataclass(frozen=True, slots=True)
-class ElementChange:
-    """An element's change set: its files' statement changes and its metrics before and after."""
+class ElementChange(NamedTuple):
+    """An element's change set: its files' statement changes and its metrics before and after
+    (a named tuple: a diff makes one per element of the tree)."""
 
     element: str
     location: Location
@@ -96,13 +124,14 @@ class ElementChange:
     file_changes: tuple[FileChange, ...] = ()  # the detail behind added/removed/modified
 
     def to_dict(self) -> dict[str, JsonValue]:
+        pre, post = self.pre, self.post
         return {
             "element": self.element,
             "location": self.location.value,
             "files": list(self.files),
             "status": self.status.value,
-            "pre": self.pre.to_dict() if self.pre else None,
-            "post": self.post.to_dict() if self.post else None,
+            "pre": None if pre is None else dict(zip(_METRIC_FIELDS, pre, strict=True)),
+            "post": None if post is None else dict(zip(_METRIC_FIELDS, post, strict=True)),
             "added": self.added,
             "removed": self.removed,
             "modified": self.modified,

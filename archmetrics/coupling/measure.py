@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
 
 from archmetrics.coupling.bindings import module_bindings
 from archmetrics.coupling.config_links import with_config_sites
@@ -34,6 +36,54 @@ from archmetrics.facts import FileFacts, Language
 _C_FAMILY = frozenset({Language.C.value, Language.CPP.value})
 
 
+class Reaching(Protocol):
+    """What finding link sites reads of a dependency occurrence: the name written and the
+    tree file it resolved to (an :class:`Occurrence`, or the coupling index's record)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def target_file(self) -> str | None: ...
+
+
+@dataclass(frozen=True, slots=True)
+class TreeLinks:
+    """What coupling one tree finds before it counts: its elements, every file's resolved
+    dependencies and each element's link sites (unresolved: ``resolve`` gives them status
+    and targets). :func:`measure_coupling` counts these; the coupling index
+    (coupling/index.py) keeps them per file."""
+
+    elements: tuple[Element, ...]
+    occurrences: Mapping[str, tuple[Occurrence, ...]]
+    sites: Mapping[str, tuple[LinkSite, ...]]  # by element name
+
+
+def link_tree(
+    files: Sequence[FileFacts],
+    options: CouplingOptions | None = None,
+    rules: RuleSet | None = None,
+    memo: SiteMemo | None = None,
+) -> TreeLinks:
+    """The elements, resolved dependencies and link sites of the tree ``files`` make up."""
+    options = options or CouplingOptions()
+    rules = rules or RuleSet()
+    by_path = {f.path: f for f in files}
+    languages = {f.path: f.language for f in files}
+    elements = group_elements(by_path, options.per_file, languages.get)
+    resolver = StaticResolver(tuple(by_path), options)
+    occurrences = {path: resolver.resolve_file(facts) for path, facts in by_path.items()}
+    may_link = LinkFilter(rules)
+    plans = [(e, path) for e in elements for path in e.files if may_link(by_path[path])]
+    by_file = Sites(by_path, occurrences, rules, memo).of(plans)
+    found: dict[str, list[LinkSite]] = {e.name: [] for e in elements}
+    for element, path in plans:
+        found[element.name].extend(by_file[path])
+    code = {name: tuple(s) for name, s in found.items()}
+    sites = with_config_sites(code, elements, by_path, rules.configuration)
+    return TreeLinks(elements, occurrences, sites)
+
+
 def measure_coupling(
     files: Sequence[FileFacts],
     options: CouplingOptions | None = None,
@@ -46,19 +96,13 @@ def measure_coupling(
     without them only static coupling is measured. ``memo``: where each file's link sites
     are kept by content (sitememo.py); the report is the same with or without it.
     """
-    options = options or CouplingOptions()
-    rules = rules or RuleSet()
-    by_path = {f.path: f for f in files}
-    languages = {f.path: f.language for f in files}
-    elements = group_elements(by_path, options.per_file, languages.get)
+    links = link_tree(files, options, rules, memo)
+    elements = links.elements
     element_of = element_of_file(elements)
-    resolver = StaticResolver(tuple(by_path), options)
-    occurrences = {path: resolver.resolve_file(facts) for path, facts in by_path.items()}
-    dependencies = {e.name: element_dependencies(e, occurrences, element_of) for e in elements}
-    constants = _Constants(by_path)
-    found = _Sites(by_path, occurrences, rules, constants, memo).of(elements)
-    found = with_config_sites(found, elements, by_path, rules.configuration)
-    sites = resolve({e.name: found[e.name] for e in elements})
+    dependencies = {
+        e.name: element_dependencies(e, links.occurrences, element_of) for e in elements
+    }
+    sites = resolve({e.name: links.sites[e.name] for e in elements})
     afferent = dependents(dependencies)
     incoming = _incoming(sites)
     return CouplingReport(
@@ -92,7 +136,7 @@ class _Constants:
         return find
 
 
-def _reachable(path: str, occurrences: Mapping[str, tuple[Occurrence, ...]]) -> list[str]:
+def _reachable(path: str, occurrences: Mapping[str, Sequence[Reaching]]) -> list[str]:
     """``path`` and the tree files it includes or imports, transitively, breadth-first."""
     order, seen = [path], {path}
     for current in order:  # grows while iterating: a breadth-first queue
@@ -103,33 +147,28 @@ def _reachable(path: str, occurrences: Mapping[str, tuple[Occurrence, ...]]) -> 
     return order
 
 
-class _Sites:
-    """Each element's unresolved link sites, file by file: read back from the memo where a
-    file's key is kept, else found by the rules (and kept)."""
+class Sites:
+    """Files' unresolved link sites: read back from the memo where a file's key is kept,
+    else found by the rules (and kept). ``by_path`` may be a mapping that reads facts when
+    asked: only the files a plan reaches are asked for."""
 
     def __init__(
         self,
         by_path: Mapping[str, FileFacts],
-        occurrences: Mapping[str, tuple[Occurrence, ...]],
+        occurrences: Mapping[str, Sequence[Reaching]],
         rules: RuleSet,
-        constants: _Constants,
         memo: SiteMemo | None,
     ) -> None:
         self.by_path, self.occurrences = by_path, occurrences
-        self.rules, self.constants, self.memo = rules, constants, memo
+        self.rules, self.constants, self.memo = rules, _Constants(by_path), memo
 
-    def of(self, elements: Sequence[Element]) -> dict[str, tuple[LinkSite, ...]]:
-        by_path, may_link = self.by_path, LinkFilter(self.rules)
-        plans = [
-            (e, path, _reachable(path, self.occurrences))
-            for e in elements
-            for path in e.files
-            if may_link(by_path[path])
-        ]
+    def of(self, plans: Sequence[tuple[Element, str]]) -> dict[str, tuple[LinkSite, ...]]:
+        """The sites of each planned file (a file of an element that a rule may link)."""
+        reaches = [(e, path, _reachable(path, self.occurrences)) for e, path in plans]
         known: dict[str, tuple[LinkSite, ...]] = {}
         keys: dict[str, str] = {}
         if self.memo is not None:
-            for element, path, reachable in plans:
+            for element, path, reachable in reaches:
                 bindings = [(o.name, o.target_file) for o in self.occurrences.get(path, ())]
                 key = site_key(self.memo, path, reachable, element.files, bindings)
                 if key is not None:
@@ -141,18 +180,18 @@ class _Sites:
                 if read is not None:
                     known[path] = read
         kept: dict[str, bytes] = {}
-        found: dict[str, list[LinkSite]] = {e.name: [] for e in elements}
-        for element, path, reachable in plans:
+        found: dict[str, tuple[LinkSite, ...]] = {}
+        for element, path, reachable in reaches:
             sites = known.get(path)
             if sites is None:
                 sites = self._file(element, path, reachable)
                 record = encode_sites(path, sites) if path in keys else None
                 if record is not None:
                     kept[keys[path]] = record
-            found[element.name].extend(sites)
+            found[path] = sites
         if kept and self.memo is not None:
             self.memo.store.put_many(kept)
-        return {name: tuple(sites) for name, sites in found.items()}
+        return found
 
     def _file(self, element: Element, path: str, reachable: list[str]) -> tuple[LinkSite, ...]:
         by_path, occurrences = self.by_path, self.occurrences

@@ -34,9 +34,24 @@ class StaticResolver:
     """Resolves the dependencies of the files of one tree."""
 
     def __init__(self, paths: Sequence[str], options: CouplingOptions) -> None:
-        self.options = options
-        self.includes = IncludeIndex(paths, options.include_dirs)
-        self.modules = ModuleIndex(paths, options.python_roots)
+        self.options, self.paths = options, paths
+        self._includes: IncludeIndex | None = None
+        self._modules: ModuleIndex | None = None
+
+    @property
+    def includes(self) -> IncludeIndex:
+        """The tree's files indexed for includes (when a file first has one: a patch that
+        resolves one C file again need not index the tree's Python modules)."""
+        if self._includes is None:
+            self._includes = IncludeIndex(self.paths, self.options.include_dirs)
+        return self._includes
+
+    @property
+    def modules(self) -> ModuleIndex:
+        """The tree's Python modules indexed for imports (when a file first has one)."""
+        if self._modules is None:
+            self._modules = ModuleIndex(self.paths, self.options.python_roots)
+        return self._modules
 
     def _ignored(self, dep: Dependency) -> bool:
         if dep.kind is DependencyKind.IMPORT:

@@ -17,6 +17,12 @@ from pathlib import Path
 import git
 from git.exc import GitCommandError, GitError, InvalidGitRepositoryError, NoSuchPathError
 
+from archmetrics.sources.gitdelta import (
+    Pending,
+    commit_delta,
+    index_delta,
+    worktree_delta,
+)
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import (
     EMPTY,
@@ -181,6 +187,15 @@ class RevisionSnapshot(_BlobReader):
         self.commit = resolve(repo, rev)
         self.label = rev
 
+    @property
+    def tree(self) -> str:
+        """The commit's tree id: what names this snapshot's content."""
+        return _ls(self.repo, "rev-parse", f"{self.commit}^{{tree}}")[0].strip()
+
+    def delta_from(self, commit: str) -> Pending:
+        """What differs from ``commit`` (a commit id) to this commit (gitdelta.py)."""
+        return commit_delta(self.repo, commit, self.commit)
+
     def files(self) -> tuple[SourceFile, ...]:
         found = []
         for entry in _ls(self.repo, "ls-tree", "-r", "-z", "--full-tree", self.commit):
@@ -195,6 +210,10 @@ class IndexSnapshot(_BlobReader):
     """What is staged (stage 0 entries; an unmerged path is read from stage 2, 'ours')."""
 
     label = INDEX
+
+    def delta_from(self, commit: str) -> Pending:
+        """What differs from ``commit`` (a commit id) to what is staged (gitdelta.py)."""
+        return index_delta(self.repo, commit)
 
     def files(self) -> tuple[SourceFile, ...]:
         found: dict[str, SourceFile] = {}
@@ -213,13 +232,28 @@ class WorktreeSnapshot(DirectorySnapshot):
     A tracked file git finds unchanged since it was staged comes with the index's blob, so
     it is neither read nor hashed unless its facts must be parsed (then the bytes read are
     hashed, as every file's are): a diff of the work tree after editing one file reads that
-    file, not every file (docs/performance.md)."""
+    file, not every file (docs/performance.md). The tree is listed when its files are first
+    asked for: a diff that patches a known state asks git what changed instead
+    (:meth:`delta_from`)."""
 
     def __init__(self, repo: git.Repo):
-        root = toplevel(repo)
-        paths = _ls(repo, "ls-files", "-z", "--cached", "--others", "--exclude-standard")
-        super().__init__(root, sorted(set(paths)), label=WORKTREE)
-        self._hashes = _unchanged_blobs(repo)
+        super().__init__(toplevel(repo), (), label=WORKTREE)
+        self.repo = repo
+        self._listed = False
+
+    def files(self) -> tuple[SourceFile, ...]:
+        if not self._listed:
+            paths = _ls(self.repo, "ls-files", "-z", "--cached", "--others", "--exclude-standard")
+            self._paths = tuple(sorted(set(paths)))
+            self._hashes = _unchanged_blobs(self.repo)
+            self._listed = True
+        return super().files()
+
+    def delta_from(self, commit: str) -> Pending:
+        """What differs from ``commit`` (a commit id) to this work tree (gitdelta.py), being
+        worked out; the files it names can be read from this snapshot."""
+        pending = worktree_delta(self.repo, commit, str(self.root))
+        return pending.then(lambda delta: self._on_disk.update(delta.on_disk))
 
 
 def _unchanged_blobs(repo: git.Repo) -> dict[str, str]:

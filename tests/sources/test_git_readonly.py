@@ -57,6 +57,21 @@ def test_measuring_changes_no_file_under_the_work_tree_or_git(
     assert checksums(repo.root) == before
 
 
+@pytest.mark.parametrize("head", ["WORKTREE", "INDEX", "v2"])
+def test_a_diff_patching_a_kept_state_changes_no_file(
+    repo: GitRepo, tmp_path: Path, head: str
+) -> None:
+    """The incremental path (a cache, a base commit's kept state, git asked what differs)
+    writes nothing under the work tree or .git either, stale index stat data included."""
+    _history(repo)
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+    before = checksums(repo.root)
+    for _ in range(2):  # the base's state kept, then patched
+        run = run_cli(["diff", "--base", "v1", "--head", head, *cache], repo.root)
+        assert run.code == 0, run.err
+    assert checksums(repo.root) == before
+
+
 def test_a_diff_works_while_another_git_holds_the_index_lock(repo: GitRepo) -> None:
     _history(repo)
     lock = repo.root / ".git" / "index.lock"
