@@ -232,9 +232,9 @@ class Bus:
                 context: Mapping[str, Any] | None = None) -> None:
         """Publish to every subscriber of ``topic``; never blocks (see fault behaviour)."""
         self._check_open()
-        raw = encode_broadcast(Kind.PUBLISH, topic, check_payload(payload),
-                               dict(context) if context else None)
-        self.adapter.publish(topic_channel(topic), raw)
+        frames = encode_broadcast(Kind.PUBLISH, topic, check_payload(payload),
+                                  dict(context) if context else None)
+        self.adapter.publish(topic_channel(topic), frames)
         counter = self._publishers.get(topic)
         if counter is None:
             counter = self._publishers[topic] = self.stats_book.counter(topic, "publisher")
@@ -249,9 +249,9 @@ class Bus:
              context: Mapping[str, Any] | None = None) -> None:
         """Emit a lightweight event (no service, no reply, no registration)."""
         self._check_open()
-        raw = encode_broadcast(Kind.EVENT, name, check_payload(payload),
-                               dict(context) if context else None)
-        self.adapter.publish(event_channel(name), raw)
+        frames = encode_broadcast(Kind.EVENT, name, check_payload(payload),
+                                  dict(context) if context else None)
+        self.adapter.publish(event_channel(name), frames)
 
     def on(self, name: str, callback: Callback | None = None,
            queue_size: int | None = None) -> Subscription:

@@ -131,7 +131,7 @@ def _defaults(d: ServiceDescriptor) -> Iterator[Problem]:
             continue
         if p.required:
             yield Problem(d.source, p.line, label, "a required value cannot have a default")
-        elif not p.type.is_primitive:
+        elif not p.type.is_primitive or p.type.name == "bytes":
             yield Problem(d.source, p.line, label, f"type '{p.type}' cannot have a default")
         elif default_value(p.type, p.default) is None:
             yield Problem(d.source, p.line, label, f"default '{p.default}' is not a valid {p.type}")
@@ -243,12 +243,12 @@ def _text_encoding(d: ServiceDescriptor, op: Operation, line: int, here: str) ->
 
 def _c_operation(d: ServiceDescriptor, op: Operation, here: str) -> Iterator[Problem]:
     for value in (*op.parameters, *op.returns):
-        if not value.type.is_primitive:
+        if not value.type.is_primitive or value.type.name == "bytes":
             yield Problem(
                 d.source,
                 value.line,
                 f"operation '{op.name}' '{value.name}'",
-                f"type '{value.type}' cannot cross a C call (primitives only)",
+                f"type '{value.type}' cannot cross a C call (int, float, bool, string only)",
             )
     if len(op.returns) > 1:
         yield Problem(

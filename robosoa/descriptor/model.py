@@ -89,7 +89,7 @@ class Profile(StrEnum):
     UNCHECKED = "unchecked"
 
 
-PRIMITIVES: tuple[str, ...] = ("int", "float", "bool", "string")
+PRIMITIVES: tuple[str, ...] = ("int", "float", "bool", "string", "bytes")
 
 
 @dataclass(frozen=True, slots=True)

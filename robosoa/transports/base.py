@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from robosoa.errors import RobosoaError
-from robosoa.message import Message
+from robosoa.message import Frames, Message
 from robosoa.stats import StatsBook
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
@@ -143,8 +143,9 @@ class ProtocolAdapter(ABC):
 
     # --- broker (publish/subscribe and events) --------------------------------------
     @abstractmethod
-    def publish(self, channel: str, raw: bytes) -> None:
-        """Send an encoded message to every subscriber of ``channel`` (never blocks; may drop)."""
+    def publish(self, channel: str, frames: Frames) -> None:
+        """Send an encoded message (``encode_broadcast``: the JSON frame and its binary
+        frames) to every subscriber of ``channel`` (never blocks; may drop)."""
 
     @abstractmethod
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:

@@ -19,7 +19,7 @@ from typing import Any
 import zmq
 
 from robosoa.errors import BusClosed, InvalidMessage, RequestTimeout, RobosoaError
-from robosoa.message import Message, decode, encode
+from robosoa.message import Frames, Message, decode_frames, encode_frames
 from robosoa.transports.base import (
     BusOptions,
     Inbox,
@@ -29,12 +29,19 @@ from robosoa.transports.base import (
 )
 from robosoa.transports.zmq_inbox import ZmqInbox
 from robosoa.transports.zmq_pubsub import Feed
-from robosoa.transports.zmq_sockets import check_endpoint, limit_input, public
+from robosoa.transports.zmq_sockets import (
+    check_endpoint,
+    limit_input,
+    public,
+    recv_rest,
+    send_frames,
+)
 from robosoa.wire import load_object
 
 SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
 SLICE_MS = int(SLICE * 1000) + 1
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
+_RCVMORE = int(zmq.RCVMORE)
 SOCKETS_PER_THREAD = 64  # consumer DEALERs kept per thread (least recently used closed)
 
 
@@ -144,12 +151,12 @@ class ZmqAdapter(ProtocolAdapter):
                 self._sockets.discard(sock)
             sock.close(0)
 
-    def _send(self, endpoint: str, raw: bytes, wait: float) -> zmq.Socket[bytes]:
+    def _send(self, endpoint: str, frames: Frames, wait: float) -> zmq.Socket[bytes]:
         sock = self._dealer(endpoint)
         deadline = time.monotonic() + wait
         while True:
             try:
-                sock.send(raw, _NOBLOCK)
+                send_frames(sock, frames, _NOBLOCK)
                 return sock
             except zmq.Again:
                 remaining = deadline - time.monotonic()
@@ -159,7 +166,7 @@ class ZmqAdapter(ProtocolAdapter):
                 sock.poll(int(min(remaining, SLICE) * 1000) + 1, zmq.POLLOUT)
 
     def _receive(self, sock: zmq.Socket[bytes], deadline: float,
-                 accept: Callable[[bytes], Any]) -> Any:
+                 accept: Callable[[list[bytes]], Any]) -> Any:
         """Wait for the reply ``accept`` recognises (stale replies are skipped).
 
         Blocks in ``recv`` with a receive timeout (no poller: cheaper on the hot path), in
@@ -179,7 +186,7 @@ class ZmqAdapter(ProtocolAdapter):
             finally:
                 if wait != SLICE_MS:
                     sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-            found = accept(data)
+            found = accept(recv_rest(sock, data) if sock.getsockopt(_RCVMORE) else [data])
             if found is not None:
                 return found
 
@@ -197,13 +204,16 @@ class ZmqAdapter(ProtocolAdapter):
         raw = json.dumps({**request, "rid": rid}).encode()
         deadline = time.monotonic() + timeout
         try:
-            sock = self._send(self.endpoint, raw, timeout)
+            sock = self._send(self.endpoint, [raw], timeout)
         except Unreachable:
             raise RobosoaError(f"location service at {self.endpoint} is not reachable") from None
 
-        def accept(data: bytes) -> dict[str, Any] | None:
+        def accept(frames: list[bytes]) -> dict[str, Any] | None:
             try:
-                reply = load_object(data, self.options.max_message, self.options.max_depth)
+                if len(frames) != 1:
+                    raise InvalidMessage(f"expected one frame, got {len(frames)}")
+                reply = load_object(frames[0], self.options.max_message,
+                                    self.options.max_depth)
             except InvalidMessage:
                 self.rejected("location")
                 return None
@@ -225,11 +235,11 @@ class ZmqAdapter(ProtocolAdapter):
 
     def _call(self, endpoint: str, msg: Message, timeout: float) -> Message:
         deadline = time.monotonic() + timeout
-        sock = self._send(endpoint, encode(msg), min(timeout, 0.5))
+        sock = self._send(endpoint, encode_frames(msg), min(timeout, 0.5))
 
-        def accept(data: bytes) -> Message | None:
+        def accept(frames: list[bytes]) -> Message | None:
             try:
-                reply = decode(data, self.options.max_message, self.options.max_depth)
+                reply = decode_frames(frames, self.options.max_message, self.options.max_depth)
             except InvalidMessage:
                 self.rejected("reply")
                 return None
@@ -246,7 +256,7 @@ class ZmqAdapter(ProtocolAdapter):
     def post(self, endpoint: str, msg: Message) -> None:
         self._enter()
         try:
-            self._send(endpoint, encode(msg), 0.5)
+            self._send(endpoint, encode_frames(msg), 0.5)
         finally:
             self._leave()
 
@@ -274,8 +284,8 @@ class ZmqAdapter(ProtocolAdapter):
             raise BusClosed(f"bus {self.address} is not connected")
         return self._feed
 
-    def publish(self, channel: str, raw: bytes) -> None:
-        self._live_feed().publish(channel, raw)
+    def publish(self, channel: str, frames: Frames) -> None:
+        self._live_feed().publish(channel, frames)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         return self._live_feed().subscribe(channel, sink)

@@ -8,9 +8,9 @@ from collections.abc import Callable
 import zmq
 
 from robosoa.errors import InvalidMessage
-from robosoa.message import Kind, Message, decode, encode
+from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
-from robosoa.transports.zmq_sockets import bind_provider, limit_input
+from robosoa.transports.zmq_sockets import bind_provider, limit_input, recv_rest, send_frames
 
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
 _MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
@@ -18,7 +18,8 @@ _RCVMORE = int(zmq.RCVMORE)
 
 
 class ZmqInbox(Inbox):
-    """A provider ROUTER: one frame of JSON per message, replies routed by identity.
+    """A provider ROUTER: a JSON frame (and its binary frames) per message, replies routed
+    by identity.
 
     The serving thread blocks in ``recv`` (receive timeout); ``wake`` sends a secret token to
     our own endpoint, so no poller is needed on the hot path.
@@ -52,23 +53,17 @@ class ZmqInbox(Inbox):
         except zmq.Again:
             return None
         data = router.recv() if router.getsockopt(_RCVMORE) else b""
-        extra = 0
-        while router.getsockopt(_RCVMORE):
-            router.recv()
-            extra += 1
+        frames = recv_rest(router, data) if router.getsockopt(_RCVMORE) else [data]
 
         def reply(msg: Message) -> None:
-            raw = encode(msg)
+            out = encode_frames(msg)
             router.send(identity, _MORE_NOBLOCK)
-            router.send(raw, _NOBLOCK)
+            send_frames(router, out, _NOBLOCK)
 
-        if extra:
-            self._rejected("inbox")
-            return Incoming(None, f"expected one message frame, got {extra + 1}", reply)
-        if data == self._token:
+        if len(frames) == 1 and data == self._token:
             return None
         try:
-            msg = decode(data, self._options.max_message, self._options.max_depth)
+            msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:  # answered with an error reply by the provider
             self._rejected("inbox")
             return Incoming(None, str(exc), reply)

@@ -15,10 +15,11 @@ from collections.abc import Callable
 
 import zmq
 
+from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
-from robosoa.message import Kind, Message, decode, encode
+from robosoa.message import Frames, Kind, Message, decode_frames, encode
 from robosoa.transports.base import BusOptions, Sink
-from robosoa.transports.zmq_sockets import Waker, limit_input
+from robosoa.transports.zmq_sockets import Waker, limit_input, recv_rest, send_frames
 
 log = logging.getLogger("robosoa.zmq")
 
@@ -44,10 +45,7 @@ def _frame(channel: str) -> bytes:
 
 def _receive(sub: zmq.Socket[bytes]) -> list[bytes]:
     """One multipart message without pyzmq's generic loop (raises zmq.Again when empty)."""
-    frames = [sub.recv(_NOBLOCK)]
-    while sub.getsockopt(_RCVMORE):
-        frames.append(sub.recv(_NOBLOCK))
-    return frames
+    return recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
 
 
 class Feed:
@@ -74,12 +72,12 @@ class Feed:
         self._thread = threading.Thread(target=self._run, daemon=True, name="robosoa-sub")
         self._thread.start()
 
-    def publish(self, channel: str, raw: bytes) -> None:
+    def publish(self, channel: str, frames: Frames) -> None:
         """Send one message; ZeroMQ drops it for subscribers whose queues are full."""
         with self._pub_lock:
             try:
                 self._pub.send(_frame(channel), _MORE_NOBLOCK)
-                self._pub.send(raw, _NOBLOCK)
+                send_frames(self._pub, frames, _NOBLOCK)
             except zmq.Again:
                 self.unsent += 1
 
@@ -110,7 +108,7 @@ class Feed:
         """Publish probes on ``channel`` until one comes back through the broker."""
         token = uuid.uuid4().hex
         arrived = self._probes[token] = threading.Event()
-        probe = encode(Message(Kind.EVENT, topic=channel, context={PROBE: token}))
+        probe = [encode(Message(Kind.EVENT, topic=channel, context={PROBE: token}))]
         try:
             for _ in range(int(SYNC_TIMEOUT / 0.02)):
                 self.publish(channel, probe)
@@ -146,11 +144,11 @@ class Feed:
         return endpoint
 
     def _deliver(self, frames: list[bytes]) -> None:
-        if len(frames) != 2:
+        if len(frames) < 2:
             self._rejected("broadcast")
             return
         try:
-            msg = decode(frames[1], self._options.max_message, self._options.max_depth)
+            msg = decode_frames(frames[1:], self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})

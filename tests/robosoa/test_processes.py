@@ -114,9 +114,16 @@ def test_malformed_bytes_get_an_error_reply_and_the_provider_survives(zmq_url: s
                 reply = json.loads(raw.recv())
                 assert reply["kind"] == "reply" and reply["error"]
                 assert reply["context"]["error_type"] == "InvalidMessage"
-            raw.send_multipart([b"two", b"frames"])
-            assert raw.poll(5000)
-            assert "frame" in json.loads(raw.recv())["error"]
+            request = json.dumps({"kind": "request", "operation": "echo"}).encode()
+            for frames, why in (([request, b"undeclared"], "binary frames"),
+                                ([json.dumps({"kind": "request", "operation": "echo",
+                                              "payload": {"a": 1}, "blobs": [["a"]]}).encode(),
+                                  b"x"], "null"),
+                                ([json.dumps({"kind": "request", "operation": "echo",
+                                              "blobs": [["a"]]}).encode()], "blobs")):
+                raw.send_multipart(frames)
+                assert raw.poll(5000)
+                assert why in json.loads(raw.recv())["error"]
             assert bus.request(name, "echo", {"n": 1})["echo"] == {"n": 1}
             # junk broadcast on a topic: subscribers drop it and keep receiving
             got: list[robosoa.Message] = []
