@@ -15,6 +15,7 @@ from robosoa.channel import Channel
 from robosoa.errors import (
     BusClosed,
     InvalidMessage,
+    ProviderLost,
     RemoteError,
     RemoteInvalidMessage,
     RequestTimeout,
@@ -55,7 +56,7 @@ def bridge(source: Bus, target: Bus, services: tuple[str, ...] | list[str] = (),
 
 __all__ = [
     "ERROR_EVENT", "Bridge", "Bus", "BusClosed", "BusOptions", "Channel", "InvalidMessage",
-    "Kind", "Message", "ProviderHandle", "RemoteError", "RemoteInvalidMessage",
+    "Kind", "Message", "ProviderHandle", "ProviderLost", "RemoteError", "RemoteInvalidMessage",
     "RequestTimeout", "RobosoaError", "Router", "RuleError", "ServiceFigures", "ServiceInfo",
     "ServiceNotFound", "Subscription", "bridge", "connect",
 ]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import socket
 import threading
@@ -17,6 +18,7 @@ from robosoa.directory import Directory
 from robosoa.dispatch import Builtin, Dispatcher, Handler, Validator
 from robosoa.errors import (
     BusClosed,
+    ProviderLost,
     RequestTimeout,
     RobosoaError,
     ServiceNotFound,
@@ -35,7 +37,9 @@ from robosoa.provider import ERROR_EVENT, ProviderHandle
 from robosoa.registrar import Registrar
 from robosoa.stats import Counter, ServiceFigures
 from robosoa.subscription import Callback, Subscription
-from robosoa.transports.base import BusOptions, ProtocolAdapter, Unreachable
+from robosoa.transports.base import BusOptions, Lost, ProtocolAdapter, Unreachable
+
+log = logging.getLogger("robosoa.bus")
 
 TARGETS = ("one", "group", "all")
 ASYNC_WORKERS = 8  # asynchronous requests run on this many threads per bus
@@ -67,8 +71,11 @@ class Bus:
     # --- providers -----------------------------------------------------------------
     def provide(self, name: str, handler: Handler, version: str = "1.0.0",
                 operations: tuple[str, ...] | list[str] = (), pattern: str = "request-response",
-                group: str | None = None, validator: Validator | None = None) -> ProviderHandle:
-        """Offer a service; the handler runs on the instance's own thread, one message at a time."""
+                group: str | None = None, validator: Validator | None = None,
+                idempotent: tuple[str, ...] | list[str] = ()) -> ProviderHandle:
+        """Offer a service; the handler runs on the instance's own thread, one message at a
+        time. ``idempotent`` names the operations a consumer may retry on another instance
+        when this one is lost mid-request."""
         self._check_open()
         if pattern not in PATTERNS:
             raise ValueError(f"unknown pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
@@ -80,12 +87,16 @@ class Bus:
                                   "figures": [f.to_dict() for f in self.stats()]},
         }
         dispatcher = Dispatcher(name, handler, tuple(operations), validator, builtins)
+        unknown = set(idempotent) - set(dispatcher.operations) if dispatcher.operations else ()
+        if unknown:
+            raise ValueError(f"idempotent names unknown operations: {', '.join(sorted(unknown))}")
         inbox = self.adapter.open_inbox(instance)
         info = ServiceInfo(name, version, dispatcher.operations, pattern, inbox.endpoint,
-                           instance, group, socket.gethostname(), os.getpid(), self.options.ttl)
+                           instance, group, socket.gethostname(), os.getpid(), self.options.ttl,
+                           idempotent=tuple(idempotent))
         handle = ProviderHandle(info, dispatcher, inbox, counter,
                                 lambda event: self.emit(ERROR_EVENT, event),
-                                self.registrar.remove)
+                                self.registrar.remove, self.options.deadline_slack)
         self.registrar.add(handle)
         return handle
 
@@ -102,37 +113,62 @@ class Bus:
 
     # --- request / response -------------------------------------------------------------
     def request(self, service: str, operation: str, payload: Mapping[str, Any] | None = None,
-                timeout: float = 5.0, version: str | None = None) -> Payload:
-        """Blocking request/response; RequestTimeout, ServiceNotFound or RemoteError on failure."""
+                timeout: float = 5.0, version: str | None = None,
+                idempotent: bool | None = None) -> Payload:
+        """Blocking request/response; RequestTimeout, ServiceNotFound, RemoteError or
+        ProviderLost on failure.
+
+        If the provider's connection is lost after the request went out, the request is
+        tried on another instance when it is ``idempotent`` (default: as the provider
+        registered the operation), else ProviderLost is raised at once.
+        """
         self._check_open()
         body = check_payload(payload)
         deadline = time.monotonic() + timeout
-        excluded: set[str] = set()
+        tried: set[str] = set()
+        failed: set[str] = set()
         fresh = False
         while True:
             found = self._lookup(service, version, fresh, deadline)
-            if excluded:
-                found = [i for i in found if i.instance not in excluded]
-            if not found and not excluded:
+            if not found and not tried:
                 detail = f"no provider in version range {version!r}" if version else ""
                 raise ServiceNotFound(service, detail)
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 self.stats_book.counter(service, "consumer").record(None, error=True)
-                raise RequestTimeout(service, operation, timeout)
-            if not found:  # every instance refused: wait a little and look again
+                raise RequestTimeout(service, operation, timeout, _tried(failed))
+            left = [i for i in found if i.instance not in tried] if tried else found
+            if not left:  # every instance failed: wait a little and look again
                 time.sleep(min(0.05, remaining))
-                excluded.clear()
+                tried.clear()
                 fresh = True
                 continue
-            info = self.directory.pick(found)
+            info = self.directory.pick(left)
             try:
                 return self._call_instance(info, operation, body, remaining, timeout)
-            except Unreachable:  # gone, or its bounded inbox is full: counted, try another
-                self.stats_book.counter(service, "consumer").drop()
-                excluded.add(info.instance)
-                self.directory.forget(service)
+            except (Unreachable, Lost) as exc:
+                self._failed(info, operation, exc, idempotent)
+                tried.add(info.instance)
+                failed.add(info.instance)
                 fresh = True
+
+    def _failed(self, info: ServiceInfo, operation: str, exc: RobosoaError,
+                idempotent: bool | None) -> None:
+        """An instance failed a call: pass it over for a while; a request it may have run
+        is tried again elsewhere only when idempotent (else ProviderLost)."""
+        self.directory.suspect(info)
+        counter = self.stats_book.counter(info.name, "consumer")
+        if isinstance(exc, Unreachable):  # never handed over: safe to try another instance
+            counter.drop("unreachable")
+            return
+        retry = operation in info.idempotent if idempotent is None else idempotent
+        if not retry:
+            counter.record(None, error=True)
+            why = f"not retried: operation {operation!r} is not idempotent"
+            raise ProviderLost(info.name, operation, info.instance, why) from None
+        counter.fail()
+        log.info("request retried on another instance", extra={
+            "service": info.name, "instance": info.instance, "reason": str(exc)})
 
     def _lookup(self, service: str, version: str | None, fresh: bool,
                 deadline: float) -> list[ServiceInfo]:
@@ -158,7 +194,8 @@ class Bus:
 
     def request_async(self, service: str, operation: str,
                       payload: Mapping[str, Any] | None = None, timeout: float = 5.0,
-                      version: str | None = None) -> Future[Payload]:
+                      version: str | None = None,
+                      idempotent: bool | None = None) -> Future[Payload]:
         """Asynchronous request/response: a Future resolved with the reply or the error."""
         self._check_open()
         body = check_payload(payload)
@@ -171,13 +208,14 @@ class Bus:
             if not full:
                 self._pending += 1
         if full:  # bounded: refuse rather than queue without limit
-            self.stats_book.counter(service, "consumer").drop()
+            self.stats_book.counter(service, "consumer").drop("queue")
             refused: Future[Payload] = Future()
             refused.set_exception(RobosoaError(
                 f"request {service}.{operation} refused: {self.options.queue_size} "
                 "asynchronous requests already pending"))
             return refused
-        future = executor.submit(self.request, service, operation, body, timeout, version)
+        future = executor.submit(self.request, service, operation, body, timeout, version,
+                                 idempotent)
         future.add_done_callback(self._async_done)
         return future
 
@@ -211,7 +249,7 @@ class Bus:
                 delivered += 1
                 counter.record(None)
             except Unreachable:
-                counter.drop()
+                counter.drop("unreachable")
                 self.directory.forget(service)
         if to == "one" and not delivered and len(found) > 1:
             return self.send(service, operation, payload, to, group, version)
@@ -338,4 +376,9 @@ class Bus:
 
     def __repr__(self) -> str:
         return f"<robosoa.Bus {self.adapter.address}>"
+
+
+def _tried(instances: set[str]) -> str:
+    """The detail of a timeout after failed instances."""
+    return f"no instance answered (failed: {', '.join(sorted(instances))})" if instances else ""
 

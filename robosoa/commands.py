@@ -150,13 +150,15 @@ def cmd_stats(args: argparse.Namespace) -> int:
         print(json.dumps(rows, indent=2))
         return 0
     print(f"{'INSTANCE':40} {'ROLE':10} {'KEY':16} {'COUNT':>7} {'ERRORS':>6} {'DROPPED':>7} "
-          f"{'P50_MS':>8} {'P99_MS':>8}")
+          f"{'P50_MS':>8} {'P99_MS':>8} WHY DROPPED")
     for row in rows:
         if "error" in row:
             print(f"{row['instance']:40} unreachable: {row['error']}")
             continue
+        why = ",".join(f"{k}={v}" for k, v in sorted(row["drops"].items()))
         print(f"{row['instance']:40} {row['role']:10} {row['key']:16} {row['count']:7d} "
-              f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}")
+              f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}"
+              f" {why}".rstrip())
     return 0
 
 
@@ -175,14 +177,26 @@ _FIGURE_TYPES = {"key": (str,), "role": (str,), "count": (int,), "errors": (int,
                  "dropped": (int,), "p50_ms": (int, float), "p99_ms": (int, float)}
 
 
+def _drops(value: object) -> dict[str, int] | None:
+    """A peer's drop counts by reason, if well-formed (a few short names, whole numbers)."""
+    if value is None:
+        return {}
+    if not (isinstance(value, dict) and len(value) <= 32 and all(
+            isinstance(k, str) and len(k) <= 40 and type(n) is int for k, n in value.items())):
+        return None
+    return dict(value)
+
+
 def _figure_rows(instance: str, figures: object) -> list[dict[str, Any]]:
     """Rows of the figures a peer sent; a malformed answer becomes one error row."""
     rows: list[dict[str, Any]] = []
     for fig in figures if isinstance(figures, list) else [None]:
-        if not (isinstance(fig, dict) and all(
+        drops = _drops(fig.get("drops")) if isinstance(fig, dict) else None
+        if drops is None or not (isinstance(fig, dict) and all(
                 type(fig.get(k)) in types for k, types in _FIGURE_TYPES.items())):
             return [{"instance": instance, "error": "malformed statistics"}]
-        rows.append({"instance": instance, **{k: fig[k] for k in _FIGURE_TYPES}})
+        rows.append({"instance": instance, **{k: fig[k] for k in _FIGURE_TYPES},
+                     "drops": drops})
     return rows
 
 

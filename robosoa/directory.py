@@ -13,6 +13,7 @@ from robosoa.transports.base import BusOptions, ProtocolAdapter
 
 Selection = tuple[float, list[ServiceInfo]]
 log = logging.getLogger("robosoa.bus")
+SUSPECT = 5.0  # seconds an instance that failed a call is passed over while others exist
 
 
 def _entries(services: object) -> list[ServiceInfo]:
@@ -36,6 +37,7 @@ class Directory:
         self._options = options
         self._cache: dict[str, Selection] = {}
         self._chosen: dict[tuple[str, str | None], Selection] = {}
+        self._suspects: dict[str, float] = {}  # instance -> until (monotonic)
         self._turn = itertools.count()
         self._lock = threading.Lock()
 
@@ -52,6 +54,18 @@ class Directory:
             with self._lock:
                 self._cache[name] = (time.monotonic(), infos)
         return select(infos, name, version)
+
+    def suspect(self, info: ServiceInfo) -> None:
+        """``info`` failed a call (gone, or its connection lost): pass it over for a while."""
+        now = time.monotonic()
+        with self._lock:
+            self._suspects = {k: t for k, t in self._suspects.items() if t > now}
+            self._suspects[info.instance] = now + SUSPECT
+            self._cache.pop(info.name, None)
+
+    def suspected(self, instance: str) -> bool:
+        """Whether ``instance`` failed a call within the last ``SUSPECT`` seconds."""
+        return self._suspects.get(instance, 0.0) > time.monotonic()
 
     def candidates(self, name: str, version: str | None, fresh: bool,
                    timeout: float | None = None) -> list[ServiceInfo]:
@@ -75,9 +89,12 @@ class Directory:
             self._cache.pop(name, None)
 
     def pick(self, found: list[ServiceInfo]) -> ServiceInfo:
-        """Round robin among the instances of the best version."""
+        """Round robin among the instances of the best version (not suspected, if any is)."""
         if len(found) == 1:
             return found[0]
+        if self._suspects:
+            trusted = [i for i in found if not self.suspected(i.instance)]
+            found = trusted or found
         top = [i for i in found if i.version == found[0].version]
         return top[next(self._turn) % len(top)]
 

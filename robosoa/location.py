@@ -49,6 +49,12 @@ def _text(value: Any, key: str) -> str:
     return text
 
 
+def _names(value: Any, key: str) -> tuple[str, ...]:
+    if not isinstance(value, list | tuple) or len(value) > MAX_OPERATIONS:
+        raise ValueError(f"{key} is not a list of at most {MAX_OPERATIONS}")
+    return tuple(_text(name, key) for name in value)
+
+
 def _ttl(value: Any) -> float:
     ttl = float(value)
     if not math.isfinite(ttl) or ttl < 0:
@@ -71,11 +77,13 @@ class ServiceInfo:
     pid: int = 0
     ttl: float = 0.0
     origin: str = ""  # "" when local, else the federated location service it came from
+    idempotent: tuple[str, ...] = ()  # operations a consumer may retry on another instance
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-compatible form."""
         data = asdict(self)
         data["operations"] = list(self.operations)
+        data["idempotent"] = list(self.idempotent)
         return data
 
     @staticmethod
@@ -84,18 +92,18 @@ class ServiceInfo:
         if not isinstance(data, Mapping):
             raise ValueError("bad service entry: not an object")
         try:
-            operations = data.get("operations", ())
-            if not isinstance(operations, list | tuple) or len(operations) > MAX_OPERATIONS:
-                raise ValueError(f"operations is not a list of at most {MAX_OPERATIONS}")
+            operations = _names(data.get("operations", ()), "operations")
+            idempotent = _names(data.get("idempotent", ()), "idempotent")
             info = ServiceInfo(
                 name=_text(data["name"], "name"), version=_text(data["version"], "version"),
-                operations=tuple(_text(op, "operation") for op in operations),
+                operations=operations,
                 pattern=str(data.get("pattern", "request-response")),
                 endpoint=_text(data["endpoint"], "endpoint"),
                 instance=_text(data["instance"], "instance"),
                 group=None if data.get("group") is None else _text(data["group"], "group"),
                 host=_text(data.get("host", ""), "host"), pid=int(data.get("pid", 0)),
                 ttl=_ttl(data.get("ttl", 0.0)), origin=_text(data.get("origin", ""), "origin"),
+                idempotent=idempotent,
             )
         except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"bad service entry: {exc!r}") from None
@@ -104,7 +112,7 @@ class ServiceInfo:
         if info.pattern not in PATTERNS:
             raise ValueError(f"bad service entry: unknown pattern {info.pattern[:40]!r}")
         texts = (info.name, info.version, info.endpoint, info.instance, info.group or "",
-                 info.host, info.origin, *info.operations)
+                 info.host, info.origin, *info.operations, *info.idempotent)
         if sum(map(len, texts)) > MAX_ENTRY:
             raise ValueError(f"bad service entry: more than {MAX_ENTRY} characters of text")
         return info

@@ -57,7 +57,7 @@ class Subscription:
             queue = self._queue
             if len(queue) >= self._size:
                 queue.popleft()
-                self._counter.drop()
+                self._counter.drop("depth")
             queue.append(msg)
             if len(queue) == 1:  # readers only wait on an empty queue
                 self._cond.notify()

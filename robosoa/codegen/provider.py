@@ -79,6 +79,7 @@ def _skeleton(d: ServiceDescriptor, part: Participant, protocol: str) -> list[st
         f"            pattern={q(_BUS_PATTERN.get(d.pattern, d.pattern.value))},",
         "            group=group,",
         f"            validator={validator},",
+        *(["            idempotent=IDEMPOTENT,"] if d.pattern.has_replies else []),
         "        )",
     ]
     for op in d.operations:
@@ -166,7 +167,8 @@ def render_provider(d: ServiceDescriptor, part: Participant) -> str:
         "typing": ["Any", "Protocol"],
         "robosoa": [],
         "robosoa.codegen.support": ["ExecutableRunner", "payload_of", "serve_main", "to_wire"],
-        ".types": ["DESCRIPTOR", "OPERATIONS", "SERVICE", "VERSION", *types_imported(d)],
+        ".types": ["DESCRIPTOR", "OPERATIONS", "SERVICE", "VERSION",
+                   *(["IDEMPOTENT"] if d.pattern.has_replies else []), *types_imported(d)],
     }
     if part.os.value != "any":
         groups["robosoa.codegen.support"].append("check_platform")

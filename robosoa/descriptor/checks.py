@@ -141,6 +141,10 @@ def _pattern(d: ServiceDescriptor) -> Iterator[Problem]:
     if d.delivery != "one" and d.pattern is not Pattern.ONE_WAY:
         yield Problem(d.source, d.line, "pattern", "delivery applies to one-way only")
     for op in d.operations:
+        if op.idempotent and not d.pattern.has_replies:
+            yield Problem(d.source, op.line, f"operation '{op.name}' attribute 'idempotent'",
+                          "applies to request-response and point-to-point only (a retry "
+                          "after a lost reply)")
         if op.returns and not d.pattern.has_replies:
             yield Problem(
                 d.source,

@@ -212,6 +212,7 @@ def _operation(element: _Element) -> Operation:
         returns=tuple(_typed(e) for e in element.findall("return")),
         definition=_text(element.find("definition")),
         line=_line(element),
+        idempotent=element.get("idempotent") in ("true", "1"),
     )
 
 

@@ -144,6 +144,7 @@ class Operation:
     returns: tuple[Parameter, ...]
     definition: str
     line: int
+    idempotent: bool = False  # a consumer may retry it on another instance (fail-over)
 
 
 @dataclass(frozen=True, slots=True)

@@ -25,6 +25,11 @@ class Unreachable(RobosoaError):
     """A provider endpoint cannot take a message right now (gone, or its queue is full)."""
 
 
+class Lost(RobosoaError):
+    """The connection to an endpoint went away after a message was handed over to it (the
+    peer died, or heartbeats stopped coming back): no reply can come any more."""
+
+
 @dataclass(frozen=True, slots=True)
 class BusOptions:
     """Tunables of one bus; every queue is bounded by one of these numbers."""
@@ -40,6 +45,9 @@ class BusOptions:
     advertise_host: str = ""  # zmq: host name/IP other machines use to reach our providers
     max_message: int = MAX_MESSAGE  # bytes per frame taken from a peer (ZeroMQ MAXMSGSIZE)
     max_depth: int = MAX_DEPTH  # JSON nesting taken from a peer (robosoa.wire)
+    link_heartbeat: float = 1.0  # zmq: seconds between ZMTP heartbeats on every connection
+    link_timeout: float = 3.0  # zmq: a connection silent this long is closed (peer dead/cut off)
+    deadline_slack: float = 0.0  # a provider still runs requests this late (clocks that differ)
 
 
 class Incoming(NamedTuple):

@@ -12,7 +12,6 @@ import itertools
 import json
 import threading
 import time
-from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
 
@@ -23,26 +22,18 @@ from robosoa.message import Frames, Message, decode_frames, encode_frames
 from robosoa.transports.base import (
     BusOptions,
     Inbox,
+    Lost,
     ProtocolAdapter,
     Sink,
     Unreachable,
 )
+from robosoa.transports.zmq_dealers import Dealers
 from robosoa.transports.zmq_inbox import ZmqInbox
 from robosoa.transports.zmq_pubsub import Feed
-from robosoa.transports.zmq_sockets import (
-    check_endpoint,
-    limit_input,
-    public,
-    recv_rest,
-    send_frames,
-)
+from robosoa.transports.zmq_sockets import check_endpoint, public
 from robosoa.wire import load_object
 
-SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
-SLICE_MS = int(SLICE * 1000) + 1
-_NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
-_RCVMORE = int(zmq.RCVMORE)
-SOCKETS_PER_THREAD = 64  # consumer DEALERs kept per thread (least recently used closed)
+CONNECT_WAIT = 0.5  # seconds a new connection to a provider gets to come up
 
 
 class ZmqAdapter(ProtocolAdapter):
@@ -55,9 +46,7 @@ class ZmqAdapter(ProtocolAdapter):
         self.endpoint = address.removeprefix("zmq://")
         check_endpoint(self.endpoint)  # validates early, with a readable error
         self._ctx: zmq.Context[zmq.Socket[bytes]] | None = None
-        self._local = threading.local()
-        self._sockets: set[zmq.Socket[bytes]] = set()
-        self._lock = threading.Lock()
+        self._dealers: Dealers | None = None
         self._rids = itertools.count(1)
         self._closing = False
         self._in_flight = 0
@@ -69,6 +58,7 @@ class ZmqAdapter(ProtocolAdapter):
     def configure(self) -> None:
         if self._ctx is None:
             self._ctx = zmq.Context()
+            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing)
 
     def connect(self) -> None:
         if self._closing:
@@ -98,11 +88,8 @@ class ZmqAdapter(ProtocolAdapter):
         if self._feed is not None:
             self._feed.close()
             self._feed = None
-        with self._lock:
-            sockets = list(self._sockets)
-            self._sockets.clear()
-        for sock in sockets:
-            sock.close(0)
+        if self._dealers is not None:
+            self._dealers.close()
         if self._ctx is not None:
             self._ctx.destroy(linger=0)
             self._ctx = None
@@ -115,80 +102,6 @@ class ZmqAdapter(ProtocolAdapter):
     def maintain(self) -> None:
         """Follow a restarted location service whose broker endpoints changed."""
         self.connect()
-
-    # --- consumer sockets (one DEALER per thread and endpoint) -------------------------
-    def _dealer(self, endpoint: str) -> zmq.Socket[bytes]:
-        if self._closing or self._ctx is None:
-            raise BusClosed(f"bus {self.address} is closed")
-        cache: OrderedDict[str, zmq.Socket[bytes]] | None = getattr(self._local, "dealers", None)
-        if cache is None:
-            cache = self._local.dealers = OrderedDict()
-        sock = cache.get(endpoint)
-        if sock is not None:
-            cache.move_to_end(endpoint)
-            return sock
-        sock = self._ctx.socket(zmq.DEALER)
-        sock.setsockopt(zmq.LINGER, 0)
-        sock.setsockopt(zmq.IMMEDIATE, 1)  # never queue for a peer that is not connected
-        sock.setsockopt(zmq.SNDHWM, self.options.hwm)
-        sock.setsockopt(zmq.RCVHWM, self.options.hwm)
-        sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-        limit_input(sock, self.options.max_message)
-        sock.connect(endpoint)
-        cache[endpoint] = sock
-        with self._lock:
-            self._sockets.add(sock)
-        if len(cache) > SOCKETS_PER_THREAD:
-            self._drop(cache.popitem(last=False)[0], cache)
-        return sock
-
-    def _drop(self, endpoint: str, cache: OrderedDict[str, zmq.Socket[bytes]] | None = None
-              ) -> None:
-        cache = cache if cache is not None else getattr(self._local, "dealers", None)
-        sock = None if cache is None else cache.pop(endpoint, None)
-        if sock is not None:
-            with self._lock:
-                self._sockets.discard(sock)
-            sock.close(0)
-
-    def _send(self, endpoint: str, frames: Frames, wait: float) -> zmq.Socket[bytes]:
-        sock = self._dealer(endpoint)
-        deadline = time.monotonic() + wait
-        while True:
-            try:
-                send_frames(sock, frames, _NOBLOCK)
-                return sock
-            except zmq.Again:
-                remaining = deadline - time.monotonic()
-                if remaining <= 0 or self._closing:
-                    self._drop(endpoint)
-                    raise Unreachable(f"no connection to {endpoint}") from None
-                sock.poll(int(min(remaining, SLICE) * 1000) + 1, zmq.POLLOUT)
-
-    def _receive(self, sock: zmq.Socket[bytes], deadline: float,
-                 accept: Callable[[list[bytes]], Any]) -> Any:
-        """Wait for the reply ``accept`` recognises (stale replies are skipped).
-
-        Blocks in ``recv`` with a receive timeout (no poller: cheaper on the hot path), in
-        slices so that closing the bus ends the wait promptly.
-        """
-        while True:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0 or self._closing:
-                return None
-            wait = int(min(remaining, SLICE) * 1000) + 1
-            if wait != SLICE_MS:  # the socket is created with SLICE; shorter waits set it
-                sock.setsockopt(zmq.RCVTIMEO, wait)
-            try:
-                data = sock.recv()
-            except zmq.Again:
-                continue
-            finally:
-                if wait != SLICE_MS:
-                    sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-            found = accept(recv_rest(sock, data) if sock.getsockopt(_RCVMORE) else [data])
-            if found is not None:
-                return found
 
     def location(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
         self._enter()
@@ -203,8 +116,9 @@ class ZmqAdapter(ProtocolAdapter):
         rid = next(self._rids)
         raw = json.dumps({**request, "rid": rid}).encode()
         deadline = time.monotonic() + timeout
+        dealers = self._live_dealers()
         try:
-            sock = self._send(self.endpoint, [raw], timeout)
+            sock = dealers.send(self.endpoint, [raw], timeout, fail_fast=False)
         except Unreachable:
             raise RobosoaError(f"location service at {self.endpoint} is not reachable") from None
 
@@ -219,9 +133,12 @@ class ZmqAdapter(ProtocolAdapter):
                 return None
             return reply if reply.get("rid") == rid else None
 
-        reply: dict[str, Any] | None = self._receive(sock, deadline, accept)
+        try:
+            reply: dict[str, Any] | None = dealers.receive(sock, self.endpoint, deadline, accept)
+        except Lost:
+            raise RobosoaError(f"location service at {self.endpoint}: connection lost") from None
         if reply is None:
-            self._drop(self.endpoint)
+            dealers.drop(self.endpoint)
             raise RobosoaError(f"location service at {self.endpoint} did not answer "
                                f"within {timeout:g}s")
         return reply
@@ -235,7 +152,8 @@ class ZmqAdapter(ProtocolAdapter):
 
     def _call(self, endpoint: str, msg: Message, timeout: float) -> Message:
         deadline = time.monotonic() + timeout
-        sock = self._send(endpoint, encode_frames(msg), min(timeout, 0.5))
+        dealers = self._live_dealers()
+        sock = dealers.send(endpoint, encode_frames(msg), min(timeout, CONNECT_WAIT))
 
         def accept(frames: list[bytes]) -> Message | None:
             try:
@@ -245,9 +163,9 @@ class ZmqAdapter(ProtocolAdapter):
                 return None
             return reply if reply.correlation_id in (msg.id, "") else None
 
-        reply: Message | None = self._receive(sock, deadline, accept)
+        reply: Message | None = dealers.receive(sock, endpoint, deadline, accept)
         if reply is None:
-            self._drop(endpoint)
+            dealers.drop(endpoint)
             if self._closing:
                 raise BusClosed(f"bus {self.address} closed during the request")
             raise RequestTimeout(msg.service, msg.operation, timeout)
@@ -256,9 +174,14 @@ class ZmqAdapter(ProtocolAdapter):
     def post(self, endpoint: str, msg: Message) -> None:
         self._enter()
         try:
-            self._send(endpoint, encode_frames(msg), 0.5)
+            self._live_dealers().send(endpoint, encode_frames(msg), CONNECT_WAIT)
         finally:
             self._leave()
+
+    def _live_dealers(self) -> Dealers:
+        if self._dealers is None or self._closing:
+            raise BusClosed(f"bus {self.address} is closed")
+        return self._dealers
 
     def _enter(self) -> None:
         """Count a call in flight so ``shutdown`` never closes a socket another thread uses."""

@@ -10,7 +10,13 @@ import zmq
 from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
-from robosoa.transports.zmq_sockets import bind_provider, limit_input, recv_rest, send_frames
+from robosoa.transports.zmq_sockets import (
+    bind_provider,
+    keepalive,
+    limit_input,
+    recv_rest,
+    send_frames,
+)
 
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
 _MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
@@ -35,6 +41,7 @@ class ZmqInbox(Inbox):
         self._router.setsockopt(zmq.RCVHWM, options.inbox_size)
         self._router.setsockopt(zmq.SNDHWM, options.hwm)
         limit_input(self._router, options.max_message)
+        keepalive(self._router, options.link_heartbeat, options.link_timeout)
         self.endpoint = bind_provider(self._router, location,
                                       options.provider_bind,
                                       options.advertise_host)

@@ -19,6 +19,7 @@ from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
 from robosoa.transports.zmq_sockets import (
     check_endpoint,
+    keepalive,
     limit_input,
     location_request,
     split_endpoint,
@@ -28,6 +29,7 @@ from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_object
 log = logging.getLogger("robosoa.location")
 
 PEER_TIMEOUT = 0.3  # seconds a federated lookup may take before the peer is skipped
+LINK_HEARTBEAT, LINK_TIMEOUT = 1.0, 3.0  # ZMTP heartbeats, as BusOptions' defaults
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,6 +110,7 @@ class LocationServer:
         sock.setsockopt(zmq.SNDHWM, hwm)
         sock.setsockopt(zmq.RCVHWM, hwm)
         limit_input(sock, self.config.max_message)
+        keepalive(sock, LINK_HEARTBEAT, LINK_TIMEOUT)
         try:
             sock.bind(bind)
         except zmq.ZMQError as exc:

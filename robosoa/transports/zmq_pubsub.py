@@ -19,7 +19,13 @@ from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
 from robosoa.message import Frames, Kind, Message, decode_frames, encode
 from robosoa.transports.base import BusOptions, Sink
-from robosoa.transports.zmq_sockets import Waker, limit_input, recv_rest, send_frames
+from robosoa.transports.zmq_sockets import (
+    Waker,
+    keepalive,
+    limit_input,
+    recv_rest,
+    send_frames,
+)
 
 log = logging.getLogger("robosoa.zmq")
 
@@ -60,6 +66,7 @@ class Feed:
         self._pub = ctx.socket(zmq.PUB)
         self._pub.setsockopt(zmq.LINGER, 0)
         self._pub.setsockopt(zmq.SNDHWM, options.hwm)
+        keepalive(self._pub, options.link_heartbeat, options.link_timeout)
         self._pub.connect(broker[0])
         self._pub_lock = threading.Lock()
         self._sinks: dict[str, tuple[Sink, ...]] = {}  # replaced, never mutated: lock-free reads
@@ -167,6 +174,7 @@ class Feed:
         sub.setsockopt(zmq.LINGER, 0)
         sub.setsockopt(zmq.RCVHWM, self._options.hwm)
         limit_input(sub, self._options.max_message)
+        keepalive(sub, self._options.link_heartbeat, self._options.link_timeout)
         endpoint = self._broker[1]
         sub.connect(endpoint)
         poller = zmq.Poller()

@@ -92,6 +92,16 @@ def recv_rest(sock: zmq.Socket[bytes], first: bytes,
     return frames
 
 
+def keepalive(sock: zmq.Socket[bytes], heartbeat: float, timeout: float) -> None:
+    """ZMTP heartbeats: a PING every ``heartbeat`` s; a connection that brings nothing back
+    for ``timeout`` s is closed (also asked of the peer, as the TTL), so a dead or cut-off
+    peer is noticed by ZeroMQ itself, not at the end of a request's timeout. 0 turns it off."""
+    if heartbeat > 0:
+        sock.setsockopt(zmq.HEARTBEAT_IVL, max(1, int(heartbeat * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TIMEOUT, max(1, int(timeout * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TTL, min(6_553_599, max(100, int(timeout * 1000))))
+
+
 def limit_input(sock: zmq.Socket[bytes], max_message: int) -> None:
     """Refuse frames larger than ``max_message`` bytes from peers (ZeroMQ drops the peer)."""
     sock.setsockopt(zmq.MAXMSGSIZE, max_message)

@@ -128,7 +128,7 @@ CAMERA = """\
       <field name="pixels" type="bytes"/><field name="width" type="int"/>
     </struct>
   </types>
-  <operation name="snap">
+  <operation name="snap" idempotent="true">
     <param name="mask" type="bytes"/>
     <param name="tiles" type="list[bytes]" required="false"/>
     <return name="image" type="Image"/>

@@ -123,3 +123,34 @@ def start_provider(url: str, name: str, version: str = "1.0.0", group: str = "")
     proc = Proc([PYTHON, "-c", PROVIDER, url, name, version, group])
     proc.wait_line("ready")
     return proc
+
+
+WORKER = textwrap.dedent('''
+    import os, signal, sys, threading, time, robosoa
+    url, name, role, idempotent, advertise = sys.argv[1:6]
+    where = {"provider_bind": "tcp://127.0.0.1", "advertise_host": advertise} if advertise else {}
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0, **where)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    def work(n):
+        if role == "victim":
+            print("busy", n, flush=True)
+            stop.wait(60)
+        return {"pid": os.getpid(), "n": n, "role": role}
+    bus.provide(name, {"work": work}, idempotent=("work",) if idempotent == "yes" else ())
+    print("ready", os.getpid(), flush=True)
+    stop.wait()
+    bus.close()
+''')
+
+
+def start_worker(url: str, name: str, role: str, idempotent: bool,
+                 advertise: str = "") -> Proc:
+    """A provider of ``name`` whose ``work`` hangs (role ``victim``: prints ``busy`` first)
+    or answers at once (``spare``); ``work`` is registered idempotent or not. With
+    ``advertise`` (e.g. 127.0.0.2) it binds 127.0.0.1 and registers that host instead, so
+    consumers reach it only through a relay listening there."""
+    proc = Proc([PYTHON, "-c", WORKER, url, name, role, "yes" if idempotent else "no",
+                 advertise])
+    proc.wait_line("ready")
+    return proc
