@@ -23,7 +23,7 @@ from robosoa.errors import (
     RobosoaError,
     ServiceNotFound,
 )
-from robosoa.location import PATTERNS, ServiceInfo
+from robosoa.location import INTERNAL, PATTERNS, ServiceInfo
 from robosoa.message import (
     Kind,
     Message,
@@ -79,6 +79,8 @@ class Bus:
         self._check_open()
         if pattern not in PATTERNS:
             raise ValueError(f"unknown pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
+        if name.startswith(INTERNAL):
+            raise ValueError(f"service names starting with {INTERNAL!r} are the runtime's own")
         instance = f"{name}-{socket.gethostname()}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
         counter = self.stats_book.counter(name, "provider")
         builtins: dict[str, Builtin] = {
@@ -277,6 +279,13 @@ class Bus:
         if counter is None:
             counter = self._publishers[topic] = self.stats_book.counter(topic, "publisher")
         counter.record(None)
+
+    def advertise(self, topic: str) -> None:
+        """Declare that this bus publishes ``topic``: on zmq it binds and registers the bus's
+        PUB now (shared by all its topics and events), so subscribers have found it by the
+        time the first message goes out. ``publish`` does it on its first call otherwise."""
+        self._check_open()
+        self.adapter.advertise(topic_channel(topic))
 
     def subscribe(self, topic: str, callback: Callback | None = None,
                   queue_size: int | None = None) -> Subscription:

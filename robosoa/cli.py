@@ -52,13 +52,11 @@ def _location_limits(p: argparse.ArgumentParser) -> None:
 
 
 def _server_commands(sub: Any) -> None:
-    p = sub.add_parser("location", help="run a location service and message broker")
+    p = sub.add_parser("location", help="run a location service")
     p.add_argument("--bind", default="tcp://127.0.0.1:5555", help="location endpoint")
-    p.add_argument("--xsub", help="broker input endpoint (default: port+1 or PATH.xsub)")
-    p.add_argument("--xpub", help="broker output endpoint (default: port+2 or PATH.xpub)")
+    p.add_argument("--announce", help="endpoint of announcements of new publishers "
+                   "(default: port+1 or PATH.announce)")
     p.add_argument("--ttl", type=float, default=3.0, help="default entry TTL in seconds")
-    p.add_argument("--hwm", type=int, default=1000,
-                   help="broker queue per publisher and per subscriber (messages; then drops)")
     p.add_argument("--federate", action="append", metavar="ENDPOINT",
                    help="also answer for services of this location service (repeatable)")
     _location_limits(p)

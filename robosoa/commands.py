@@ -19,7 +19,7 @@ from robosoa.errors import RobosoaError
 from robosoa.location import ServiceInfo
 
 DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
-PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so the broker knows its subscribers
+PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so that subscribers have joined it
 
 
 def location_url(text: str | None) -> str:
@@ -53,8 +53,8 @@ def cmd_location(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: server.stop())
-    print(f"robosoa location service on {server.endpoint} "
-          f"xsub={server.broker[0]} xpub={server.broker[1]}", flush=True)
+    print(f"robosoa location service on {server.endpoint} announce={server.announce}",
+          flush=True)
     server.serve()
     return 0
 
@@ -101,6 +101,7 @@ def cmd_publish(args: argparse.Namespace) -> int:
     """Publish a topic message (``--count`` times, ``--interval`` apart)."""
     payload = parse_pairs(args.pairs, args.json)
     with _bus(args) as bus:
+        bus.advertise(args.topic)
         time.sleep(PUBLISH_SETTLE)
         for n in range(args.count):
             if n:

@@ -29,6 +29,8 @@ PATTERNS = ("request-response", "oneway", "publish-subscribe", "event", "point-t
 MAX_TEXT = 1024  # characters of one text field of a registration (name, endpoint, ...)
 MAX_OPERATIONS = 1024  # operations one registration may list
 MAX_ENTRY = 16 * 1024  # characters of all text of one registration together
+INTERNAL = "robosoa."  # names the runtime registers for itself; providers may not use them
+PUBLISHERS = "robosoa.pub"  # a bus's PUB sockets: subscribers connect to them directly
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,6 +142,7 @@ class Registry:
                  limits: Limits = Limits()) -> None:
         self._entries: dict[str, tuple[ServiceInfo, float, str]] = {}  # (info, expiry, peer)
         self._per_peer: collections.Counter[str] = collections.Counter()
+        self._publishers = 0  # changes of the PUBLISHERS entries (a generation counter)
         self._default_ttl = default_ttl
         self._limits = limits
         self._clock = clock
@@ -157,6 +160,8 @@ class Registry:
             elif old[2] != peer:
                 raise RegistryFull(f"instance {info.instance[:80]!r} belongs to another peer")
             self._entries[info.instance] = (info, self._clock() + ttl, peer)
+            if info.name == PUBLISHERS and (old is None or old[0].endpoint != info.endpoint):
+                self._publishers += 1
         if old is None:
             log.info("registered", extra={"service": info.name, "instance": info.instance,
                                           "endpoint": info.endpoint, "peer": peer})
@@ -172,8 +177,13 @@ class Registry:
                                f"{limits.max_per_peer} entries (max_per_peer)")
         self._per_peer[peer] += 1
 
+    def publishers(self) -> int:
+        """How many times ``PUBLISHERS`` entries came, went or moved (a change counter)."""
+        return self._publishers
+
     def _drop(self, instance: str) -> ServiceInfo:
         info, _, peer = self._entries.pop(instance)
+        self._publishers += info.name == PUBLISHERS
         self._per_peer[peer] -= 1
         if self._per_peer[peer] <= 0:
             del self._per_peer[peer]

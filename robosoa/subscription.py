@@ -49,11 +49,11 @@ class Subscription:
         """Messages dropped because this subscription's queue was full."""
         return self._counter.figures().dropped
 
-    def sink(self, msg: Message) -> None:
+    def sink(self, msg: Message, size: int = 0, expires: float = 0.0) -> bool:
         """Enqueue without blocking; drop the oldest message when full."""
         with self._cond:
             if self._closed:
-                return
+                return True
             queue = self._queue
             if len(queue) >= self._size:
                 queue.popleft()
@@ -61,6 +61,7 @@ class Subscription:
             queue.append(msg)
             if len(queue) == 1:  # readers only wait on an empty queue
                 self._cond.notify()
+        return True
 
     def get(self, timeout: float | None = None) -> Message | None:
         """The next message, or None on timeout or once closed."""

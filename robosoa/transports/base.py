@@ -13,11 +13,14 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from robosoa.errors import RobosoaError
+from robosoa.location import ServiceInfo
 from robosoa.message import Frames, Message
 from robosoa.stats import StatsBook
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
-Sink = Callable[[Message], None]  # must never block: it enqueues into a bounded queue
+# (message, its size in bytes on the wire, the expiry its publisher gave it or 0) -> whether
+# it was taken (False: a reliable subscription is full; offer it again later). Never blocks.
+Sink = Callable[[Message, int, float], bool]
 ReplyFn = Callable[[Message], None]
 
 
@@ -126,6 +129,16 @@ class ProtocolAdapter(ABC):
     def maintain(self) -> None:
         """Periodic housekeeping, called from the bus's heartbeat thread (default: nothing)."""
         return None
+
+    def advertise(self, channel: str) -> None:
+        """Get ready to publish on ``channel`` so subscribers can find this bus before its
+        first message (default: nothing to prepare)."""
+        return None
+
+    def registrations(self) -> list[ServiceInfo]:
+        """Entries the transport keeps registered for itself besides the providers (e.g. a
+        PUB socket subscribers connect to); the bus's heartbeats refresh them."""
+        return []
 
     # --- location service -----------------------------------------------------------
     @abstractmethod

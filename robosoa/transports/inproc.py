@@ -195,8 +195,9 @@ class InprocAdapter(ProtocolAdapter):
             sinks = list(broker.channels.get(channel, ()))
         if sinks:
             delivered = decode_frames(frames, self.options.max_message, self.options.max_depth)
+            size = sum(map(len, frames))
             for sink in sinks:
-                sink(delivered)
+                sink(delivered, size, 0.0)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         broker = self._live()

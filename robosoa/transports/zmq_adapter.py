@@ -1,13 +1,15 @@
 """The ZeroMQ transport: providers and consumers in separate processes or machines.
 
 Topology (see docs/runtime.md): a location-service process binds a ROUTER for the location
-protocol and runs an XSUB/XPUB forwarder (the message broker) for topics and events. Each
-provider instance binds its own ROUTER and registers that endpoint; consumers connect a
-DEALER per (thread, endpoint) and talk to providers directly.
+protocol and a PUB for announcements. Each provider instance binds its own ROUTER and
+registers that endpoint; consumers connect a DEALER per (thread, endpoint) and talk to
+providers directly. Each bus that publishes binds its own PUB and registers it; subscribers
+connect to every registered PUB directly (``zmq_topics``): there is no broker.
 """
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import threading
@@ -18,6 +20,7 @@ from typing import Any
 import zmq
 
 from robosoa.errors import BusClosed, InvalidMessage, RequestTimeout, RobosoaError
+from robosoa.location import ServiceInfo
 from robosoa.message import Frames, Message, decode_frames, encode_frames
 from robosoa.transports.base import (
     BusOptions,
@@ -29,8 +32,8 @@ from robosoa.transports.base import (
 )
 from robosoa.transports.zmq_dealers import Dealers
 from robosoa.transports.zmq_inbox import ZmqInbox
-from robosoa.transports.zmq_pubsub import Feed
 from robosoa.transports.zmq_sockets import check_endpoint, public
+from robosoa.transports.zmq_topics import Topics
 from robosoa.wire import load_object
 
 CONNECT_WAIT = 0.5  # seconds a new connection to a provider gets to come up
@@ -51,14 +54,15 @@ class ZmqAdapter(ProtocolAdapter):
         self._closing = False
         self._in_flight = 0
         self._idle = threading.Condition()
-        self._feed: Feed | None = None
-        self._broker: tuple[str, str] = ("", "")
+        self._topics: Topics | None = None
 
     # --- SOA_Base ---------------------------------------------------------------------
     def configure(self) -> None:
         if self._ctx is None:
             self._ctx = zmq.Context()
             self._dealers = Dealers(self._ctx, self.options, lambda: self._closing)
+            self._topics = Topics(self._ctx, self.endpoint, self.options, self.location,
+                                  self.rejected, self._lost)
 
     def connect(self) -> None:
         if self._closing:
@@ -66,28 +70,28 @@ class ZmqAdapter(ProtocolAdapter):
         self.configure()
         self.connected = True
         hello = self.location({"op": "hello"}, self.options.location_timeout)
-        broker = (public(str(hello.get("xsub", "")), self.endpoint),
-                  public(str(hello.get("xpub", "")), self.endpoint))
-        if not all(broker):
-            raise RobosoaError(f"location service at {self.endpoint} has no message broker")
-        if self._feed is None:
-            assert self._ctx is not None
-            self._feed = Feed(self._ctx, broker, self.options, self.rejected)
-        elif broker != self._broker:
-            self._feed.move(broker)
-        self._broker = broker
+        announce = public(str(hello.get("announce", "")), self.endpoint)
+        if not announce:
+            raise RobosoaError(f"location service at {self.endpoint} makes no announcements "
+                               "(an older robosoa?)")
+        assert self._topics is not None
+        self._topics.follow(announce)
 
     def disconnect(self) -> None:
         self.connected = False
 
     def shutdown(self) -> None:
+        if self.connected and not self._closing:
+            for info in self.registrations():  # best effort; otherwise they expire
+                with contextlib.suppress(RobosoaError):
+                    self.location({"op": "unregister", "instance": info.instance}, 0.5)
         self.connected = False
         with self._idle:
             self._closing = True  # waits in flight end within one SLICE
             self._idle.wait_for(lambda: self._in_flight == 0, timeout=2.0)
-        if self._feed is not None:
-            self._feed.close()
-            self._feed = None
+        if self._topics is not None:
+            self._topics.close()
+            self._topics = None
         if self._dealers is not None:
             self._dealers.close()
         if self._ctx is not None:
@@ -100,8 +104,16 @@ class ZmqAdapter(ProtocolAdapter):
         return time.perf_counter() - start
 
     def maintain(self) -> None:
-        """Follow a restarted location service whose broker endpoints changed."""
+        """Follow a restarted location service whose announcement endpoint changed."""
         self.connect()
+
+    def registrations(self) -> list[ServiceInfo]:
+        """This bus's PUB, once it has published."""
+        return self._topics.registrations() if self._topics is not None else []
+
+    def _lost(self, channel: str, n: int) -> None:
+        """Messages a publisher sent on ``channel`` that never arrived (sequence gap)."""
+        self.stats_book.counter(channel[2:], "subscriber").drop("lost", n)
 
     def location(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
         self._enter()
@@ -202,13 +214,16 @@ class ZmqAdapter(ProtocolAdapter):
             raise BusClosed(f"bus {self.address} is not connected")
         return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected)
 
-    def _live_feed(self) -> Feed:
-        if self._feed is None or not self.connected:
+    def _live_topics(self) -> Topics:
+        if self._topics is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return self._feed
+        return self._topics
+
+    def advertise(self, channel: str) -> None:
+        self._live_topics().outlet()
 
     def publish(self, channel: str, frames: Frames) -> None:
-        self._live_feed().publish(channel, frames)
+        self._live_topics().publish(channel, frames)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
-        return self._live_feed().subscribe(channel, sink)
+        return self._live_topics().subscribe(channel, sink)

@@ -90,11 +90,10 @@ def start_location(bind: str, *extra: str) -> tuple[Proc, str]:
 
 
 def tcp_location(*extra: str) -> tuple[Proc, str]:
-    """A location service on three free 127.0.0.1 ports."""
-    ports = [free_port() for _ in range(3)]
+    """A location service on two free 127.0.0.1 ports (requests, announcements)."""
+    ports = [free_port() for _ in range(2)]
     return start_location(f"tcp://127.0.0.1:{ports[0]}",
-                          "--xsub", f"tcp://127.0.0.1:{ports[1]}",
-                          "--xpub", f"tcp://127.0.0.1:{ports[2]}", *extra)
+                          "--announce", f"tcp://127.0.0.1:{ports[1]}", *extra)
 
 
 PROVIDER = textwrap.dedent('''
@@ -152,5 +151,28 @@ def start_worker(url: str, name: str, role: str, idempotent: bool,
     consumers reach it only through a relay listening there."""
     proc = Proc([PYTHON, "-c", WORKER, url, name, role, "yes" if idempotent else "no",
                  advertise])
+    proc.wait_line("ready")
+    return proc
+
+
+TICKER = textwrap.dedent('''
+    import os, signal, sys, threading, robosoa
+    url, topic, every = sys.argv[1], sys.argv[2], float(sys.argv[3])
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    bus.advertise(topic)
+    print("ready", os.getpid(), flush=True)
+    n = 0
+    while not stop.wait(every):
+        n += 1
+        bus.publish(topic, {"n": n, "pid": os.getpid()})
+    bus.close()
+''')
+
+
+def start_ticker(url: str, topic: str, every: float = 0.02) -> Proc:
+    """A process publishing ``{"n": 1, 2, ...}`` on ``topic`` every ``every`` seconds."""
+    proc = Proc([PYTHON, "-c", TICKER, url, topic, str(every)])
     proc.wait_line("ready")
     return proc
