@@ -23,19 +23,20 @@ from robosoa.errors import (
     RobosoaError,
     ServiceNotFound,
 )
-from robosoa.location import INTERNAL, PATTERNS, ServiceInfo
+from robosoa.location import BUS_ENTRY, INTERNAL, PATTERNS, ServiceInfo
 from robosoa.message import (
     Kind,
     Message,
     Payload,
     check_payload,
-    encode_broadcast,
     event_channel,
     topic_channel,
 )
 from robosoa.provider import ERROR_EVENT, ProviderHandle
+from robosoa.qos import QoS
 from robosoa.registrar import Registrar
 from robosoa.stats import Counter, ServiceFigures
+from robosoa.streams import Streams
 from robosoa.subscription import Callback, Subscription
 from robosoa.transports.base import BusOptions, Lost, ProtocolAdapter, Unreachable
 
@@ -52,11 +53,11 @@ class Bus:
         self.adapter = adapter
         self.options = options or adapter.options
         self.stats_book = adapter.stats_book
-        self._subscriptions: list[Subscription] = []
         self.directory = Directory(adapter, self.options)
+        self.streams = Streams(adapter, self.options, self._expose)
         self._consumers: dict[str, Counter] = {}
-        self._publishers: dict[str, Counter] = {}
         self._lock = threading.Lock()
+        self._exposed = False
         self._closed = False
         self._executor: ThreadPoolExecutor | None = None
         self._pending = 0
@@ -81,6 +82,12 @@ class Bus:
             raise ValueError(f"unknown pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
         if name.startswith(INTERNAL):
             raise ValueError(f"service names starting with {INTERNAL!r} are the runtime's own")
+        return self._offer(name, handler, version, tuple(operations), pattern, group,
+                           validator, tuple(idempotent))
+
+    def _offer(self, name: str, handler: Handler, version: str, operations: tuple[str, ...],
+               pattern: str, group: str | None, validator: Validator | None,
+               idempotent: tuple[str, ...]) -> ProviderHandle:
         instance = f"{name}-{socket.gethostname()}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
         counter = self.stats_book.counter(name, "provider")
         builtins: dict[str, Builtin] = {
@@ -88,19 +95,30 @@ class Bus:
             "_stats": lambda _m: {"instance": instance,
                                   "figures": [f.to_dict() for f in self.stats()]},
         }
-        dispatcher = Dispatcher(name, handler, tuple(operations), validator, builtins)
+        dispatcher = Dispatcher(name, handler, operations, validator, builtins)
         unknown = set(idempotent) - set(dispatcher.operations) if dispatcher.operations else ()
         if unknown:
             raise ValueError(f"idempotent names unknown operations: {', '.join(sorted(unknown))}")
         inbox = self.adapter.open_inbox(instance)
         info = ServiceInfo(name, version, dispatcher.operations, pattern, inbox.endpoint,
                            instance, group, socket.gethostname(), os.getpid(), self.options.ttl,
-                           idempotent=tuple(idempotent))
+                           idempotent=idempotent)
         handle = ProviderHandle(info, dispatcher, inbox, counter,
                                 lambda event: self.emit(ERROR_EVENT, event),
                                 self.registrar.remove, self.options.deadline_slack)
         self.registrar.add(handle)
         return handle
+
+    def _expose(self) -> None:
+        """Once this bus publishes or listens: a hidden ``robosoa.bus`` instance answering
+        ``_ping`` and ``_stats``, so ``robosoa stats`` shows its subscribers' and publishers'
+        counters even when it provides no service."""
+        with self._lock:
+            if self._exposed:
+                return
+            self._exposed = True
+        self._offer(BUS_ENTRY, {}, "1.0.0", ("_ping", "_stats"), "request-response", None,
+                    None, ())
 
     # --- lookup ----------------------------------------------------------------------
     def services(self, name: str | None = None, version: str | None = None) -> list[ServiceInfo]:
@@ -267,61 +285,41 @@ class Bus:
             raise ServiceNotFound(service, f"no instance {instance!r}" if instance else "")
         return Channel(self._call_instance, self.adapter, found[0])
 
-    # --- publish / subscribe, events ------------------------------------------------------
+    # --- publish / subscribe, events (robosoa.streams) -------------------------------------
+    def advertise(self, topic: str, qos: QoS | None = None, event: bool = False) -> None:
+        """Declare that this bus publishes ``topic`` (an event with ``event=True``), with the
+        publishing side of ``qos``: ``lifespan`` travels with each message, ``reliable``
+        makes publish wait up to ``block`` for a full subscriber. On zmq it also binds and
+        registers the bus's PUB now, so subscribers have found it by the first message;
+        ``publish`` does that on its first call otherwise."""
+        self._check_open()
+        self.streams.advertise(event_channel(topic) if event else topic_channel(topic), qos)
+
     def publish(self, topic: str, payload: Mapping[str, Any] | None = None,
                 context: Mapping[str, Any] | None = None) -> None:
-        """Publish to every subscriber of ``topic``; never blocks (see fault behaviour)."""
+        """Publish to every subscriber of ``topic``; never blocks, unless the topic was
+        advertised reliable (then PublishTimeout after its ``block`` seconds)."""
         self._check_open()
-        frames = encode_broadcast(Kind.PUBLISH, topic, check_payload(payload),
-                                  dict(context) if context else None)
-        self.adapter.publish(topic_channel(topic), frames)
-        counter = self._publishers.get(topic)
-        if counter is None:
-            counter = self._publishers[topic] = self.stats_book.counter(topic, "publisher")
-        counter.record(None)
-
-    def advertise(self, topic: str) -> None:
-        """Declare that this bus publishes ``topic``: on zmq it binds and registers the bus's
-        PUB now (shared by all its topics and events), so subscribers have found it by the
-        time the first message goes out. ``publish`` does it on its first call otherwise."""
-        self._check_open()
-        self.adapter.advertise(topic_channel(topic))
+        self.streams.send(Kind.PUBLISH, topic, payload, context)
 
     def subscribe(self, topic: str, callback: Callback | None = None,
-                  queue_size: int | None = None) -> Subscription:
-        """Receive ``topic``: with a callback (own thread) or by iterating the subscription."""
-        return self._listen(topic_channel(topic), topic, callback, queue_size)
+                  queue_size: int | None = None, qos: QoS | None = None) -> Subscription:
+        """Receive ``topic``: with a callback (own thread) or by iterating the subscription.
+        ``qos`` bounds and shapes its queue (``queue_size`` overrides its depth)."""
+        self._check_open()
+        return self.streams.listen(topic_channel(topic), topic, callback, queue_size, qos)
 
     def emit(self, name: str, payload: Mapping[str, Any] | None = None,
              context: Mapping[str, Any] | None = None) -> None:
         """Emit a lightweight event (no service, no reply, no registration)."""
         self._check_open()
-        frames = encode_broadcast(Kind.EVENT, name, check_payload(payload),
-                                  dict(context) if context else None)
-        self.adapter.publish(event_channel(name), frames)
+        self.streams.send(Kind.EVENT, name, payload, context)
 
     def on(self, name: str, callback: Callback | None = None,
-           queue_size: int | None = None) -> Subscription:
+           queue_size: int | None = None, qos: QoS | None = None) -> Subscription:
         """Listen to a lightweight event."""
-        return self._listen(event_channel(name), name, callback, queue_size)
-
-    def _listen(self, channel: str, name: str, callback: Callback | None,
-                queue_size: int | None) -> Subscription:
         self._check_open()
-        counter = self.stats_book.counter(name, "subscriber")
-        sub = Subscription(name, queue_size or self.options.queue_size, counter, callback)
-        cancel = self.adapter.subscribe(channel, sub.sink)
-
-        def detach() -> None:
-            with self._lock:
-                if sub in self._subscriptions:
-                    self._subscriptions.remove(sub)
-            cancel()
-
-        sub.attach(detach)
-        with self._lock:
-            self._subscriptions.append(sub)
-        return sub
+        return self.streams.listen(event_channel(name), name, callback, queue_size, qos)
 
     # --- infrastructure -------------------------------------------------------------------
     def federate(self, address: str) -> None:
@@ -367,10 +365,8 @@ class Bus:
         for handle in self.providers:
             handle.close()
         with self._lock:
-            subs = list(self._subscriptions)
             executor, self._executor = self._executor, None
-        for sub in subs:
-            sub.close()
+        self.streams.close()
         if executor is not None:
             executor.shutdown(wait=False, cancel_futures=True)
         self.adapter.shutdown()  # in-flight calls (heartbeats too) end within one slice

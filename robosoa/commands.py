@@ -16,7 +16,7 @@ from robosoa import connect
 from robosoa.bus import Bus
 from robosoa.cli_input import UsageError, endpoint, location_config, parse_pairs, positive
 from robosoa.errors import RobosoaError
-from robosoa.location import ServiceInfo
+from robosoa.location import BUS_ENTRY, ServiceInfo
 
 DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
 PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so that subscribers have joined it
@@ -137,9 +137,11 @@ def cmd_stats(args: argparse.Namespace) -> int:
     """Ask every provider instance for its counters and print them."""
     rows: list[dict[str, Any]] = []
     with _bus(args) as bus:
-        if args.name is None:  # the location service's own counters come first
-            rows += _location_rows(bus, args.timeout)
-        for info in bus.services(args.name):
+        infos = bus.services(args.name)
+        if args.name is None:  # the location service's own counters come first, and the
+            rows += _location_rows(bus, args.timeout)  # buses that only publish or listen
+            infos += bus.services(BUS_ENTRY)
+        for info in infos:
             try:
                 reply = bus.channel(info.name, info.instance).request("_stats", {},
                                                                        timeout=args.timeout)

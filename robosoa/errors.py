@@ -43,6 +43,16 @@ class ProviderLost(RobosoaError):
                          f"have run); {why}")
 
 
+class PublishTimeout(RobosoaError):
+    """A reliable topic's subscriber had no room for the message within the blocking time;
+    it was not sent (counted as dropped, reason ``blocked``)."""
+
+    def __init__(self, topic: str, block: float) -> None:
+        self.topic = topic
+        super().__init__(f"publish on reliable {topic!r}: a subscriber had no room for "
+                         f"{block:g}s; the message was not sent")
+
+
 class RemoteError(RobosoaError):
     """The provider answered with an error; ``reason`` is its one-line explanation."""
 

@@ -31,6 +31,7 @@ MAX_OPERATIONS = 1024  # operations one registration may list
 MAX_ENTRY = 16 * 1024  # characters of all text of one registration together
 INTERNAL = "robosoa."  # names the runtime registers for itself; providers may not use them
 PUBLISHERS = "robosoa.pub"  # a bus's PUB sockets: subscribers connect to them directly
+BUS_ENTRY = "robosoa.bus"  # a publishing or subscribing bus's _ping/_stats instance
 
 
 @dataclass(frozen=True, slots=True)

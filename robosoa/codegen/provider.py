@@ -133,6 +133,10 @@ def _publisher(d: ServiceDescriptor, part: Participant) -> list[str]:
     lines += ["    def __init__(self, bus: robosoa.Bus) -> None:", "        self._bus = bus"]
     if part.profile is Profile.CHECKED:
         lines.append("        self._check = DESCRIPTOR.validator()")
+    event = ["event=True"] if d.pattern is Pattern.EVENT else []
+    for op in d.operations:  # binds the PUB now and declares each stream's QoS
+        args = [f"SERVICE + {q('.' + op.name)}", f"DESCRIPTOR.qos({q(op.name)})", *event]
+        lines += call("        ", "bus.advertise", args)
     for op in d.operations:
         items = ", ".join(f"{q(p.name)}: {p.name}" for p in op.parameters)
         lines += [

@@ -7,21 +7,36 @@ broker channels. Adding a transport means one new module implementing this class
 
 from __future__ import annotations
 
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from robosoa.errors import RobosoaError
+from robosoa.errors import PublishTimeout, RobosoaError
 from robosoa.location import ServiceInfo
 from robosoa.message import Frames, Message
 from robosoa.stats import StatsBook
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
-# (message, its size in bytes on the wire, the expiry its publisher gave it or 0) -> whether
-# it was taken (False: a reliable subscription is full; offer it again later). Never blocks.
-Sink = Callable[[Message, int, float], bool]
+# (message, its size in bytes on the wire, the expiry its publisher gave it or 0, whether the
+# transport can hold it back) -> whether it was taken (False only when holding back is
+# possible and a reliable subscription is full: offer it again later). Never blocks.
+Sink = Callable[[Message, int, float, bool], bool]
 ReplyFn = Callable[[Message], None]
+
+
+def offer_until(sink: Sink, offer: tuple[Message, int, float], deadline: float,
+                channel: str) -> None:
+    """Offer a message until ``sink`` takes it (a reliable sink may refuse while full),
+    backing off up to 10 ms; PublishTimeout once ``deadline`` (monotonic) has passed."""
+    pause = 0.0005
+    start = time.monotonic()
+    while not sink(*offer, True):
+        if time.monotonic() >= deadline:
+            raise PublishTimeout(channel[2:], max(0.0, deadline - start))
+        time.sleep(pause)
+        pause = min(pause * 2, 0.01)
 
 
 class Unreachable(RobosoaError):
@@ -164,9 +179,17 @@ class ProtocolAdapter(ABC):
 
     # --- broker (publish/subscribe and events) --------------------------------------
     @abstractmethod
-    def publish(self, channel: str, frames: Frames) -> None:
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
         """Send an encoded message (``encode_broadcast``: the JSON frame and its binary
-        frames) to every subscriber of ``channel`` (never blocks; may drop)."""
+        frames) to every subscriber of ``channel``, with the expiry (epoch seconds, 0: none)
+        its sinks get. ``block`` None: best effort, never blocks, may drop. A number: the
+        topic is reliable, wait up to that long for room, then raise PublishTimeout."""
+
+    def room(self, channel: str) -> None:
+        """A subscription of ``channel`` that refused a message (reliable, full) has room
+        again (default: nothing to do; the publisher retries by itself)."""
+        return None
 
     @abstractmethod
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:

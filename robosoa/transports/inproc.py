@@ -23,6 +23,7 @@ from robosoa.transports.base import (
     ProtocolAdapter,
     Sink,
     Unreachable,
+    offer_until,
 )
 
 DEFAULT_NAME = "default"
@@ -189,15 +190,21 @@ class InprocAdapter(ProtocolAdapter):
             broker.inboxes[endpoint] = inbox
         return inbox
 
-    def publish(self, channel: str, frames: Frames) -> None:
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
         broker = self._live()
         with broker.lock:
             sinks = list(broker.channels.get(channel, ()))
         if sinks:
             delivered = decode_frames(frames, self.options.max_message, self.options.max_depth)
             size = sum(map(len, frames))
+            if block is None:
+                for sink in sinks:
+                    sink(delivered, size, expires, False)
+                return
+            deadline = time.monotonic() + block
             for sink in sinks:
-                sink(delivered, size, 0.0)
+                offer_until(sink, (delivered, size, expires), deadline, channel)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         broker = self._live()

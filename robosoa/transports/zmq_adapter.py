@@ -105,6 +105,8 @@ class ZmqAdapter(ProtocolAdapter):
 
     def maintain(self) -> None:
         """Follow a restarted location service whose announcement endpoint changed."""
+        if self._topics is not None:
+            self._topics.tidy()
         self.connect()
 
     def registrations(self) -> list[ServiceInfo]:
@@ -222,8 +224,13 @@ class ZmqAdapter(ProtocolAdapter):
     def advertise(self, channel: str) -> None:
         self._live_topics().outlet()
 
-    def publish(self, channel: str, frames: Frames) -> None:
-        self._live_topics().publish(channel, frames)
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
+        self._live_topics().publish(channel, frames, expires, block)
+
+    def room(self, channel: str) -> None:
+        if self._topics is not None:
+            self._topics.room(channel)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         return self._live_topics().subscribe(channel, sink)

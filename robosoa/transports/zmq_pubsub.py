@@ -1,10 +1,16 @@
-"""The subscribing side of a bus over ZeroMQ: one SUB socket connected straight to every
-publisher's PUB (no broker in between), owned by a thread that fans messages out to the
+"""The subscribing side of a bus over ZeroMQ: SUB sockets connected straight to every
+publisher (no broker in between), owned by a thread that fans messages out to the
 subscriptions' bounded queues.
 
+Two SUB sockets: one for publishers' best-effort PUBs, one for their reliable XPUBs. When a
+reliable subscription refuses a message (its queue is full), the thread keeps that message
+and stops reading the reliable socket until the subscription has room: ZeroMQ's queues and
+TCP then fill up to the publisher, whose reliable sends fail, so it waits instead of anything
+being dropped. The best-effort socket is read on meanwhile.
+
 Which publishers exist is learnt from the location service (``zmq_topics.Discovery``); once
-connected, messages flow whether or not the location service is alive. The SUB socket is also
-connected to the location service's announcements (``a:`` channel): one means "look the
+connected, messages flow whether or not the location service is alive. The best-effort SUB is
+also connected to the location service's announcements (``a:`` channel): one means "look the
 publishers up again".
 """
 
@@ -12,6 +18,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections import deque
 from collections.abc import Callable
 
@@ -19,9 +26,9 @@ import zmq
 
 from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
-from robosoa.message import decode_frames
-from robosoa.transports.base import BusOptions, Sink
-from robosoa.transports.zmq_outlet import META, prefix
+from robosoa.message import Message, decode_frames
+from robosoa.transports.base import BusOptions, Sink, offer_until
+from robosoa.transports.zmq_outlet import MARK, META, prefix
 from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
 
 log = logging.getLogger("robosoa.zmq")
@@ -47,6 +54,7 @@ class Feed:
         self._commands: deque[tuple[str, object, threading.Event | None]] = deque()
         self._waker = Waker(ctx)
         self._last: dict[tuple[int, bytes], int] = {}
+        self._held: tuple[Message, int, float, tuple[Sink, ...]] | None = None  # refused
         self._stopped = threading.Event()
         self._announce = announce
         self._thread = threading.Thread(target=self._run, daemon=True, name="robosoa-sub")
@@ -75,9 +83,14 @@ class Feed:
 
         return cancel
 
-    def connect(self, endpoints: frozenset[str], wait: bool = False) -> None:
-        """Be connected to exactly these publisher endpoints (others are disconnected)."""
+    def connect(self, endpoints: tuple[frozenset[str], frozenset[str]],
+                wait: bool = False) -> None:
+        """Be connected to exactly these publishers' best-effort and reliable endpoints."""
         self._command("peers", endpoints, wait)
+
+    def room(self) -> None:
+        """A reliable subscription has room again: offer the held-back message again."""
+        self._command("room", None)
 
     def move(self, announce: str) -> None:
         """Follow the location service's announcements to a new endpoint."""
@@ -90,77 +103,100 @@ class Feed:
         if done is not None and not done.wait(2.0) and not self._stopped.is_set():
             log.warning("subscriber thread is slow to take a command", extra={"op": op})
 
-    def _apply(self, sub: zmq.Socket[bytes], peers: set[str]) -> None:
+    def _apply(self, subs: tuple[zmq.Socket[bytes], zmq.Socket[bytes]],
+               peers: tuple[set[str], set[str]]) -> None:
         while self._commands:
             op, arg, done = self._commands.popleft()
             try:
-                if op in ("sub", "unsub"):
-                    channel = arg if isinstance(arg, bytes) else b""
-                    sub.setsockopt(zmq.SUBSCRIBE if op == "sub" else zmq.UNSUBSCRIBE,
-                                   channel + b"\0")
+                if op in ("sub", "unsub") and isinstance(arg, bytes):
+                    for sub in subs:
+                        sub.setsockopt(zmq.SUBSCRIBE if op == "sub" else zmq.UNSUBSCRIBE,
+                                       arg + b"\0")
                     if op == "unsub":  # a later subscription starts counting afresh
-                        self._last = {k: v for k, v in self._last.items() if k[1] != channel}
-                elif op == "peers" and isinstance(arg, frozenset):
-                    for gone in peers - arg:
-                        _quietly(sub.disconnect, gone)
-                    for new in arg - peers:
-                        _quietly(sub.connect, new)
-                    peers.clear()
-                    peers.update(arg)
+                        self._last = {k: v for k, v in self._last.items() if k[1] != arg}
+                elif op == "peers" and isinstance(arg, tuple):
+                    for sub, have, want in zip(subs, peers, arg, strict=True):
+                        _follow(sub, have, want)
                 elif op == "move" and isinstance(arg, str):
-                    _quietly(sub.disconnect, self._announce)
+                    _quietly(subs[0].disconnect, self._announce)
                     self._announce = arg
-                    _quietly(sub.connect, arg)
+                    _quietly(subs[0].connect, arg)
+                elif op == "room":
+                    self._retry()
             finally:
                 if done is not None:
                     done.set()
 
-    def local(self, channel: str, frames: list[bytes], expires: float) -> None:
+    def _retry(self) -> None:
+        """Offer the held-back message to the sinks that refused it (feed thread)."""
+        if self._held is not None:
+            msg, size, expires, sinks = self._held
+            waiting = tuple(s for s in sinks if not s(msg, size, expires, True))
+            self._held = (msg, size, expires, waiting) if waiting else None
+
+    def local(self, channel: str, frames: list[bytes], expires: float,
+              block: float | None) -> None:
         """A message this bus published itself: to its own subscriptions, on the caller's
-        thread (a bus never listens to its own PUB, so no message comes twice)."""
+        thread (a bus never listens to its own PUB, so no message comes twice); a reliable
+        one waits for room up to ``block`` seconds (PublishTimeout)."""
         sinks = self._sinks.get(prefix(channel)[:-1])
         if sinks:
             msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
             size = sum(map(len, frames))
+            if block is None:
+                for sink in sinks:
+                    sink(msg, size, expires, False)
+                return
+            deadline = time.monotonic() + block
             for sink in sinks:
-                sink(msg, size, expires)
+                offer_until(sink, (msg, size, expires), deadline, channel)
 
-    def _deliver(self, frames: list[bytes]) -> None:
+    def _deliver(self, frames: list[bytes], hold: bool) -> bool:
+        """Hand one message to its sinks; False if a reliable one refused it (held back:
+        only for messages of the reliable socket, ``hold``)."""
         head = frames[0]
         cut = head.find(b"\0")
         if cut < 0 or len(frames) < 2:
             self._rejected("broadcast")
-            return
+            return True
         channel = head[:cut]
         if channel == ANNOUNCE:
             self._announced()
-            return
+            return True
         sinks = self._sinks.get(channel)
         if sinks is None:
-            return
+            return True
         expires = 0.0
         if len(head) - cut - 1 == META.size:
             publisher, seq, expires = META.unpack_from(head, cut + 1)
-            self._sequence(publisher, channel, seq)
+            self._sequence(publisher, channel, seq, expires == MARK)
+            if expires == MARK:
+                return True
         try:
             msg = decode_frames(frames[1:], self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
-            return
+            return True
         size = sum(map(len, frames))
-        for sink in sinks:
-            sink(msg, size, expires)
+        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
+        if refused:
+            self._held = (msg, size, expires, refused)
+        return not refused
 
-    def _sequence(self, publisher: int, channel: bytes, seq: int) -> None:
-        """Count the messages of ``publisher`` on ``channel`` that were skipped."""
+    def _sequence(self, publisher: int, channel: bytes, seq: int, mark: bool) -> None:
+        """Count the messages of ``publisher`` on ``channel`` that were skipped (up to its
+        message ``seq``, or up to and with ``seq`` for a mark)."""
         key = (publisher, channel)
         last = self._last.get(key)
         if last is None and len(self._last) >= MAX_TRACKED:
             self._last.clear()
-        self._last[key] = seq
-        if last is not None and seq > last + 1:
-            self._lost(channel.decode(errors="replace"), seq - last - 1)
+        if last is not None and seq > last:
+            missing = seq - last - (0 if mark else 1)
+            if missing > 0:
+                self._lost(channel.decode(errors="replace"), missing)
+        if last is None or seq > last or not mark:
+            self._last[key] = seq
 
     def _socket(self) -> zmq.Socket[bytes]:
         sub = self._ctx.socket(zmq.SUB)
@@ -168,38 +204,50 @@ class Feed:
         sub.setsockopt(zmq.RCVHWM, self._options.hwm)
         limit_input(sub, self._options.max_message)
         keepalive(sub, self._options.link_heartbeat, self._options.link_timeout)
-        sub.setsockopt(zmq.SUBSCRIBE, ANNOUNCE + b"\0")
-        _quietly(sub.connect, self._announce)
         return sub
 
     def _run(self) -> None:
-        sub = self._socket()
-        peers: set[str] = set()
+        lossy, reliable = self._socket(), self._socket()
+        lossy.setsockopt(zmq.SUBSCRIBE, ANNOUNCE + b"\0")
+        _quietly(lossy.connect, self._announce)
+        peers: tuple[set[str], set[str]] = (set(), set())
         poller = zmq.Poller()
-        poller.register(sub, zmq.POLLIN)
-        poller.register(self._waker.rx, zmq.POLLIN)
+        for sock in (lossy, reliable, self._waker.rx):
+            poller.register(sock, zmq.POLLIN)
+        paused = False
         try:
             while not self._stopped.is_set():
                 events = dict(poller.poll(500))
                 if self._waker.rx in events:
                     self._waker.drain()
-                    self._apply(sub, peers)
-                if sub in events:
-                    for _ in range(256):  # drain a batch, then look at commands again
-                        try:
-                            frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
-                        except zmq.Again:
-                            break
-                        try:
-                            self._deliver(frames)
-                        except Exception:  # never let one message end the subscriber thread
-                            log.exception("broadcast delivery failed")
+                    self._apply((lossy, reliable), peers)
+                if lossy in events:
+                    self._drain(lossy, False)
+                if reliable in events and self._held is None:
+                    self._drain(reliable, True)
+                if paused != (self._held is not None):  # hold the reliable socket back
+                    paused = not paused
+                    poller.modify(reliable, 0 if paused else zmq.POLLIN)
         finally:
-            sub.close(0)
+            lossy.close(0)
+            reliable.close(0)
             while self._commands:  # nobody waits on a command that will never run
                 done = self._commands.popleft()[2]
                 if done is not None:
                     done.set()
+
+    def _drain(self, sub: zmq.Socket[bytes], hold: bool) -> None:
+        """Deliver a batch of what ``sub`` holds; stop early at a held-back message."""
+        for _ in range(256):  # then look at commands again
+            try:
+                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+            except zmq.Again:
+                return
+            try:
+                if not self._deliver(frames, hold):
+                    return
+            except Exception:  # never let one message end the subscriber thread
+                log.exception("broadcast delivery failed")
 
     def close(self) -> None:
         """Stop the receiving thread and close its socket."""
@@ -207,6 +255,16 @@ class Feed:
         self._waker.wake()
         self._thread.join(timeout=5.0)
         self._waker.close()
+
+
+def _follow(sub: zmq.Socket[bytes], have: set[str], want: frozenset[str]) -> None:
+    """Connect ``sub`` to the endpoints of ``want`` it lacks, disconnect the others."""
+    for gone in have - want:
+        _quietly(sub.disconnect, gone)
+    for new in want - have:
+        _quietly(sub.connect, new)
+    have.clear()
+    have.update(want)
 
 
 def _quietly(call: Callable[[str], object], endpoint: str) -> None:

@@ -16,16 +16,17 @@ from typing import Any
 
 import zmq
 
-from robosoa.errors import RobosoaError
+from robosoa.errors import PublishTimeout, RobosoaError
 from robosoa.location import PUBLISHERS, ServiceInfo
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions, Sink
-from robosoa.transports.zmq_outlet import Outlet
+from robosoa.transports.zmq_outlet import RELIABLE, Outlet
 from robosoa.transports.zmq_pubsub import Feed
 
 log = logging.getLogger("robosoa.zmq")
 
 Location = Callable[[dict[str, Any], float], dict[str, Any]]
+Found = tuple[frozenset[str], frozenset[str]]  # publishers' PUB and reliable XPUB endpoints
 LOOKUP_TIMEOUT = 1.0  # seconds one look-up of the publishers may take
 QUIET = 0.05  # seconds between two look-ups prompted by announcements (however many)
 
@@ -33,8 +34,8 @@ QUIET = 0.05  # seconds between two look-ups prompted by announcements (however 
 class Discovery:
     """A thread that looks the publishers up at once when woken, and every ``every`` s."""
 
-    def __init__(self, ask: Callable[[], frozenset[str] | None],
-                 apply: Callable[[frozenset[str]], None], every: float) -> None:
+    def __init__(self, ask: Callable[[], Found | None], apply: Callable[[Found], None],
+                 every: float) -> None:
         self._ask = ask
         self._apply = apply
         self._every = every
@@ -81,7 +82,7 @@ class Topics:
         self._outlet: Outlet | None = None
         self._feed: Feed | None = None
         self._discovery: Discovery | None = None
-        self._found: frozenset[str] = frozenset()
+        self._found: Found = (frozenset(), frozenset())
         self.announce = ""
 
     def outlet(self) -> Outlet:
@@ -92,16 +93,33 @@ class Topics:
         with self._lock:
             if self._outlet is None:
                 self._outlet = Outlet(self._ctx, self._location, self._options)
-                self._register(self._outlet.info)
+                for info in self._outlet.infos:
+                    self._register(info)
             return self._outlet
 
-    def publish(self, channel: str, frames: Frames, expires: float = 0.0) -> None:
-        """Send to every subscriber connected to this bus's PUB now, and to this bus's own
-        subscriptions directly."""
-        self.outlet().publish(channel, frames, expires)
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
+        """Send to every subscriber connected to this bus's PUB now (its reliable XPUB when
+        ``block`` is given; PublishTimeout if there was no room in time), and to this bus's
+        own subscriptions directly."""
+        outlet = self.outlet()
+        if block is None:
+            outlet.publish(channel, frames, expires)
+        elif not outlet.publish_reliably(channel, frames, expires, block):
+            raise PublishTimeout(channel[2:], block)
         feed = self._feed
         if feed is not None:
-            feed.local(channel, frames, expires)
+            feed.local(channel, frames, expires, block)
+
+    def room(self, channel: str) -> None:
+        """A reliable subscription has room: the feed offers what it held back again."""
+        if self._feed is not None:
+            self._feed.room()
+
+    def tidy(self) -> None:
+        """Housekeeping of the heartbeat thread."""
+        if self._outlet is not None:
+            self._outlet.tidy()
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         """Deliver ``channel`` to ``sink``; the first call connects to every publisher."""
@@ -130,7 +148,7 @@ class Topics:
     def registrations(self) -> list[ServiceInfo]:
         """The entries this bus keeps registered for its topics (its PUB)."""
         outlet = self._outlet
-        return [outlet.info] if outlet is not None else []
+        return list(outlet.infos) if outlet is not None else []
 
     def _register(self, info: ServiceInfo) -> None:
         try:
@@ -143,8 +161,9 @@ class Topics:
         if self._discovery is not None:
             self._discovery.wake()
 
-    def _publishers(self) -> frozenset[str] | None:
-        """Endpoints of every publisher the location service knows, or None if it failed."""
+    def _publishers(self) -> Found | None:
+        """Endpoints of every publisher the location service knows (best-effort PUBs,
+        reliable XPUBs), or None if it could not be asked."""
         request = {"op": "lookup", "name": PUBLISHERS, "local": True}
         try:
             reply = self._ask(request, min(LOOKUP_TIMEOUT, self._options.location_timeout))
@@ -153,24 +172,26 @@ class Topics:
         found = reply.get("services")
         if not isinstance(found, list):
             return None
-        endpoints = set()
+        lossy: set[str] = set()
+        reliable: set[str] = set()
         for data in found:
             try:
-                endpoints.add(ServiceInfo.from_dict(data).endpoint)
+                info = ServiceInfo.from_dict(data)
             except ValueError:
                 continue
-        return frozenset(endpoints)
+            (reliable if info.group == RELIABLE else lossy).add(info.endpoint)
+        return frozenset(lossy), frozenset(reliable)
 
-    def _connected(self, found: frozenset[str]) -> None:
+    def _connected(self, found: Found) -> None:
         self._found = found
         self._connect()
 
     def _connect(self, wait: bool = False) -> None:
-        """Connect the feed to what was found, except this bus's own PUB."""
+        """Connect the feed to what was found, except this bus's own sockets."""
         feed, outlet = self._feed, self._outlet
         if feed is not None:
-            own = {outlet.endpoint} if outlet is not None else set()
-            feed.connect(self._found - own, wait)
+            own = {outlet.endpoint, outlet.reliable_endpoint} if outlet is not None else set()
+            feed.connect((self._found[0] - own, self._found[1] - own), wait)
 
     def close(self) -> None:
         """Stop discovery and the feed, close the PUB."""

@@ -111,6 +111,7 @@ SENSOR = """\
     <struct name="Pose"><field name="x" type="float"/><field name="y" type="float"/></struct>
   </types>
   <operation name="reading">
+    <qos depth="10" lifespan="30" max-bytes="65536"/>
     <param name="value" type="float"/><param name="unit" type="string" default="m"/>
     <param name="where" type="Pose" required="false"/>
   </operation>

@@ -334,8 +334,10 @@ def test_publish_subscribe_and_events_deliver_typed_messages(
     beats: list[bool] = []
     subscriptions = [
         client.on_reading(readings.append),
-        client.on_heartbeat(lambda: beats.append(True)),
+        client.on_heartbeat(lambda: beats.append(True), qos=robosoa.QoS(keep_latest=True)),
     ]
+    assert subscriptions[0].qos == robosoa.QoS(depth=10, lifespan=30.0, max_bytes=65536)
+    assert subscriptions[1].qos.keep_latest  # overridden in code
     publisher = getattr(load_module(f"{service}_provider.provider"), f"{cap}Provider")(
         publisher_bus
     )
