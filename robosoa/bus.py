@@ -102,7 +102,7 @@ class Bus:
         inbox = self.adapter.open_inbox(instance)
         info = ServiceInfo(name, version, dispatcher.operations, pattern, inbox.endpoint,
                            instance, group, socket.gethostname(), os.getpid(), self.options.ttl,
-                           idempotent=idempotent)
+                           idempotent=idempotent, key=inbox.key)
         handle = ProviderHandle(info, dispatcher, inbox, counter,
                                 lambda event: self.emit(ERROR_EVENT, event),
                                 self.registrar.remove, self.options.deadline_slack)

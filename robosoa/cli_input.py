@@ -86,4 +86,5 @@ def location_config(args: argparse.Namespace) -> LocationConfig:
                     args.federation_timeout)
     return LocationConfig(args.bind, args.announce or "", args.ttl,
                           tuple(args.federate or ()), args.max_message,
-                          args.max_depth, limits)
+                          args.max_depth, limits, args.curve_secret or "",
+                          args.curve_allow or "")

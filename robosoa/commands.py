@@ -39,7 +39,20 @@ def _checked_url(flag: str, text: str | None) -> str:
 def _bus(args: argparse.Namespace) -> Bus:
     url = _checked_url("--location", args.location)
     positive("--connect-timeout", args.connect_timeout)
-    return connect(url, location_timeout=args.connect_timeout)
+    return connect(url, location_timeout=args.connect_timeout, **_curve_options(args))
+
+
+def _curve_options(args: argparse.Namespace) -> dict[str, str]:
+    """CURVE options of a client command (empty ones fall back to the environment)."""
+    from robosoa.transports import zmq_curve as curve
+
+    options = {"curve_secret": args.curve_secret or "", "curve_allow": args.curve_allow or "",
+               "curve_location": getattr(args, "curve_location", None) or ""}
+    try:
+        curve.load(options["curve_secret"], options["curve_allow"], options["curve_location"])
+    except RobosoaError as exc:
+        raise UsageError(str(exc)) from None
+    return options
 
 
 def cmd_location(args: argparse.Namespace) -> int:
@@ -49,13 +62,41 @@ def cmd_location(args: argparse.Namespace) -> int:
     config = location_config(args)
     try:
         server = LocationServer(config)
-    except RobosoaError as exc:  # cannot bind or federate: the flags are wrong
+    except RobosoaError as exc:  # cannot bind or federate, bad keys: the flags are wrong
         raise UsageError(str(exc)) from None
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: server.stop())
     print(f"robosoa location service on {server.endpoint} announce={server.announce}",
           flush=True)
+    print(_exposure(server.endpoint, server.curve is not None), file=sys.stderr, flush=True)
     server.serve()
+    return 0
+
+
+def _exposure(endpoint: str, secured: bool) -> str:
+    """What the location service's binding means for who can join the bus."""
+    host = endpoint.removeprefix("tcp://").rpartition(":")[0].strip("[]")
+    if secured:
+        return "robosoa: CURVE on: only the keys of the allow folder can join; traffic encrypted"
+    if endpoint.startswith("ipc://") or host in ("127.0.0.1", "::1", "localhost"):
+        return ("robosoa: bound to this machine only (loopback/ipc): other machines cannot "
+                "join; to open the bus, bind an address with --curve-secret and --curve-allow "
+                "(docs/runtime.md, Security)")
+    return (f"robosoa: WARNING: {endpoint} is reachable from the network WITHOUT "
+            "authentication or encryption: anyone who reaches it can register, publish and "
+            "call; use --curve-secret and --curve-allow (docs/runtime.md, Security)")
+
+
+def cmd_keys(args: argparse.Namespace) -> int:
+    """Write a CURVE certificate pair per name."""
+    from robosoa.transports import zmq_curve as curve
+
+    for name in args.names:
+        try:
+            public, secret = curve.create(args.folder, name)
+        except RobosoaError as exc:
+            raise UsageError(str(exc)) from None
+        print(f"{public}\n{secret}")
     return 0
 
 

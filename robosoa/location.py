@@ -10,6 +10,7 @@ import collections
 import functools
 import logging
 import math
+import re
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -58,6 +59,17 @@ def _names(value: Any, key: str) -> tuple[str, ...]:
     return tuple(_text(name, key) for name in value)
 
 
+_Z85 = re.compile(r"[0-9a-zA-Z.\-:+=^!/*?&<>()\[\]{}@%$#]{40}")
+
+
+def _key(value: Any) -> str:
+    if value == "":
+        return ""
+    if not isinstance(value, str) or not _Z85.fullmatch(value):
+        raise ValueError("key is not a 40-character Z85 public key")
+    return value
+
+
 def _ttl(value: Any) -> float:
     ttl = float(value)
     if not math.isfinite(ttl) or ttl < 0:
@@ -81,6 +93,7 @@ class ServiceInfo:
     ttl: float = 0.0
     origin: str = ""  # "" when local, else the federated location service it came from
     idempotent: tuple[str, ...] = ()  # operations a consumer may retry on another instance
+    key: str = ""  # zmq with CURVE: the public key (z85) of the endpoint's server socket
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-compatible form."""
@@ -106,7 +119,7 @@ class ServiceInfo:
                 group=None if data.get("group") is None else _text(data["group"], "group"),
                 host=_text(data.get("host", ""), "host"), pid=int(data.get("pid", 0)),
                 ttl=_ttl(data.get("ttl", 0.0)), origin=_text(data.get("origin", ""), "origin"),
-                idempotent=idempotent,
+                idempotent=idempotent, key=_key(data.get("key", "")),
             )
         except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"bad service entry: {exc!r}") from None

@@ -66,6 +66,9 @@ class BusOptions:
     link_heartbeat: float = 1.0  # zmq: seconds between ZMTP heartbeats on every connection
     link_timeout: float = 3.0  # zmq: a connection silent this long is closed (peer dead/cut off)
     deadline_slack: float = 0.0  # a provider still runs requests this late (clocks that differ)
+    curve_secret: str = ""  # zmq: this participant's certificate (NAME.key_secret); "" = off
+    curve_allow: str = ""  # zmq: folder of the public certificates allowed on the bus
+    curve_location: str = ""  # zmq: the location service's certificate (default allow/location.key)
 
 
 class Incoming(NamedTuple):
@@ -83,6 +86,7 @@ class Inbox(ABC):
     """A provider instance's bounded receive queue; its endpoint is what gets registered."""
 
     endpoint: str
+    key: str = ""  # the endpoint's public key when the transport authenticates (zmq CURVE)
 
     @abstractmethod
     def receive(self, timeout: float) -> Incoming | None:

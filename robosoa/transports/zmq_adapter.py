@@ -18,10 +18,12 @@ from collections.abc import Callable
 from typing import Any
 
 import zmq
+from zmq.auth.thread import ThreadAuthenticator
 
 from robosoa.errors import BusClosed, InvalidMessage, RequestTimeout, RobosoaError
 from robosoa.location import ServiceInfo
 from robosoa.message import Frames, Message, decode_frames, encode_frames
+from robosoa.transports import zmq_curve as curve
 from robosoa.transports.base import (
     BusOptions,
     Inbox,
@@ -55,14 +57,42 @@ class ZmqAdapter(ProtocolAdapter):
         self._in_flight = 0
         self._idle = threading.Condition()
         self._topics: Topics | None = None
+        self._curve = curve.load(options.curve_secret, options.curve_allow,
+                                 options.curve_location)
+        self._auth: ThreadAuthenticator | None = None
+        self._keys: dict[str, bytes] = {}  # endpoint -> its server's CURVE key (from lookups)
 
     # --- SOA_Base ---------------------------------------------------------------------
     def configure(self) -> None:
         if self._ctx is None:
             self._ctx = zmq.Context()
-            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing)
+            if self._curve is not None:  # the ZAP handler first: nothing binds without it
+                self._auth = self._curve.authenticator(self._ctx)
+            setup = self._secure if self._curve is not None else None
+            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing, setup)
             self._topics = Topics(self._ctx, self.endpoint, self.options, self.location,
-                                  self.rejected, self._lost)
+                                  self.rejected, self._lost, self._curve)
+
+    def _secure(self, sock: zmq.Socket[bytes], endpoint: str) -> None:
+        """CURVE client set-up of a DEALER: the server key of ``endpoint``."""
+        assert self._curve is not None
+        key = self._curve.location if endpoint == self.endpoint else self._keys.get(endpoint)
+        if not key:
+            raise Unreachable(f"no CURVE key known for {endpoint}")
+        self._curve.client(sock, key)
+
+    def _learn(self, reply: dict[str, Any]) -> None:
+        """Remember the CURVE keys of the endpoints a lookup returned."""
+        found = reply.get("services")
+        if self._curve is None or not isinstance(found, list):
+            return
+        if len(self._keys) > 65536:
+            self._keys.clear()
+        for entry in found:
+            if isinstance(entry, dict):
+                endpoint, key = entry.get("endpoint"), entry.get("key")
+                if isinstance(endpoint, str) and isinstance(key, str) and len(key) == 40:
+                    self._keys[endpoint] = key.encode()
 
     def connect(self) -> None:
         if self._closing:
@@ -94,6 +124,9 @@ class ZmqAdapter(ProtocolAdapter):
             self._topics = None
         if self._dealers is not None:
             self._dealers.close()
+        if self._auth is not None:
+            self._auth.stop()
+            self._auth = None
         if self._ctx is not None:
             self._ctx.destroy(linger=0)
             self._ctx = None
@@ -155,6 +188,8 @@ class ZmqAdapter(ProtocolAdapter):
             dealers.drop(self.endpoint)
             raise RobosoaError(f"location service at {self.endpoint} did not answer "
                                f"within {timeout:g}s")
+        if request.get("op") == "lookup":
+            self._learn(reply)
         return reply
 
     def call(self, endpoint: str, msg: Message, timeout: float) -> Message:
@@ -214,7 +249,7 @@ class ZmqAdapter(ProtocolAdapter):
     def open_inbox(self, instance: str) -> Inbox:
         if self._ctx is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected)
+        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected, self._curve)
 
     def _live_topics(self) -> Topics:
         if self._topics is None or not self.connected:

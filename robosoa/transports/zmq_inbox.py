@@ -10,6 +10,7 @@ import zmq
 from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
+from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_sockets import (
     bind_provider,
     keepalive,
@@ -32,7 +33,8 @@ class ZmqInbox(Inbox):
     """
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
-                 options: BusOptions, rejected: Callable[[str], None]) -> None:
+                 options: BusOptions, rejected: Callable[[str], None],
+                 curve: Curve | None = None) -> None:
         self._ctx = ctx
         self._options = options
         self._rejected = rejected
@@ -42,6 +44,10 @@ class ZmqInbox(Inbox):
         self._router.setsockopt(zmq.SNDHWM, options.hwm)
         limit_input(self._router, options.max_message)
         keepalive(self._router, options.link_heartbeat, options.link_timeout)
+        if curve is not None:
+            curve.serve(self._router)
+            self.key = curve.public.decode()
+        self._curve = curve
         self.endpoint = bind_provider(self._router, location,
                                       options.provider_bind,
                                       options.advertise_host)
@@ -82,6 +88,8 @@ class ZmqInbox(Inbox):
         except zmq.ZMQError:
             return  # context already gone: the receiver ends at its timeout anyway
         sock.setsockopt(zmq.LINGER, 1000)
+        if self._curve is not None:  # our own key is on the allow-list
+            self._curve.client(sock, self._curve.public)
         sock.connect(self._bound.replace("0.0.0.0", "127.0.0.1"))
         sock.send(self._token, zmq.NOBLOCK)
         sock.close()

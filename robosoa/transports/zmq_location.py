@@ -22,6 +22,7 @@ import zmq
 
 from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
+from robosoa.transports import zmq_curve as curve
 from robosoa.transports.zmq_sockets import (
     check_endpoint,
     keepalive,
@@ -50,6 +51,8 @@ class LocationConfig:
     max_message: int = MAX_MESSAGE  # bytes per frame from a peer
     max_depth: int = MAX_DEPTH  # JSON nesting of one location request
     limits: Limits = field(default_factory=Limits)  # registrations, TTLs, federation
+    curve_secret: str = ""  # this service's certificate (NAME.key_secret); "" = no CURVE
+    curve_allow: str = ""  # folder of the public certificates allowed on the bus
 
 
 def _wild(endpoint: str) -> str:
@@ -70,11 +73,16 @@ def announce_bind(config: LocationConfig) -> str:
 
 
 def _peer_of(frame: zmq.Frame) -> str:
-    """Who sent ``frame``: the remote host for tcp, the process for ipc (registry ownership)."""
-    try:
-        return str(frame.get("Peer-Address"))
-    except zmq.ZMQError:
-        return ""
+    """Who sent ``frame`` (registry ownership): its CURVE public key when the bus uses CURVE,
+    else the remote host for tcp, the process for ipc."""
+    for prop in ("User-Id", "Peer-Address"):
+        try:
+            found = str(frame.get(prop))
+        except zmq.ZMQError:
+            continue
+        if found and found != "anonymous":
+            return found
+    return ""
 
 
 class LocationServer:
@@ -82,15 +90,18 @@ class LocationServer:
 
     def __init__(self, config: LocationConfig) -> None:
         self.config = config
+        self.curve = curve.load(config.curve_secret, config.curve_allow, "", server=True)
+        if self.curve is not None and config.federate:
+            raise RobosoaError("--federate is not available with CURVE yet (a federated "
+                               "location service's key cannot be given)")
         self._ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
+        self._auth = self.curve.authenticator(self._ctx) if self.curve is not None else None
         self._sockets: list[zmq.Socket[bytes]] = []
         try:  # a bind that fails (bad address, port taken) releases what was bound before
             self._router = self._socket(zmq.ROUTER, _wild(config.bind))
             self._announce = self._socket(zmq.PUB, announce_bind(config))
         except BaseException:
-            for sock in self._sockets:
-                sock.close(0)
-            self._ctx.term()
+            self._release()
             raise
         self.endpoint = self._last(self._router)
         self.announce = self._last(self._announce)
@@ -112,6 +123,8 @@ class LocationServer:
         sock.setsockopt(zmq.RCVHWM, hwm)
         limit_input(sock, self.config.max_message)
         keepalive(sock, LINK_HEARTBEAT, LINK_TIMEOUT)
+        if self.curve is not None:
+            self.curve.serve(sock)
         try:
             sock.bind(bind)
         except zmq.ZMQError as exc:
@@ -187,9 +200,14 @@ class LocationServer:
                 self.service.registry.expire()
                 self._announce_changes()
         finally:
-            for sock in self._sockets:
-                sock.close(0)
-            self._ctx.term()
+            self._release()
+
+    def _release(self) -> None:
+        for sock in self._sockets:
+            sock.close(0)
+        if self._auth is not None:
+            self._auth.stop()
+        self._ctx.term()
 
     def stop(self) -> None:
         """Make ``serve`` return (thread-safe, signal-safe)."""

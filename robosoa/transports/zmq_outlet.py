@@ -28,6 +28,7 @@ import zmq
 from robosoa.location import PUBLISHERS, ServiceInfo
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions
+from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_sockets import bind_provider, keepalive, send_frames
 
 META = struct.Struct("!QQd")  # publisher id, sequence number on the channel, expiry (epoch s)
@@ -58,11 +59,16 @@ class Outlet:
     while a subscriber's queue is full, so the publisher waits instead of dropping."""
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
-                 options: BusOptions) -> None:
+                 options: BusOptions, curve: Curve | None = None) -> None:
         self.id = random.getrandbits(64)
         self._pub = self._socket(ctx, zmq.PUB, options)
         self._reliable = self._socket(ctx, zmq.XPUB, options)
         self._reliable.setsockopt(zmq.XPUB_NODROP, 1)
+        key = ""
+        if curve is not None:
+            curve.serve(self._pub)
+            curve.serve(self._reliable)
+            key = curve.public.decode()
         try:
             self.endpoint = self._bind(self._pub, location, options)
             self.reliable_endpoint = self._bind(self._reliable, location, options)
@@ -72,7 +78,8 @@ class Outlet:
         host, pid, tag = socket.gethostname(), os.getpid(), uuid.uuid4().hex[:8]
         self.infos = tuple(
             ServiceInfo(PUBLISHERS, "1.0.0", (), "publish-subscribe", endpoint,
-                        f"pub-{host}-{pid}-{tag}{suffix}", group, host, pid, options.ttl)
+                        f"pub-{host}-{pid}-{tag}{suffix}", group, host, pid, options.ttl,
+                        key=key)
             for endpoint, group, suffix in ((self.endpoint, None, ""),
                                             (self.reliable_endpoint, RELIABLE, "-r")))
         self._seq: dict[str, int] = {}

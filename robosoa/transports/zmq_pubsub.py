@@ -28,6 +28,7 @@ from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
 from robosoa.message import Message, decode_frames
 from robosoa.transports.base import BusOptions, Sink, offer_until
+from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import MARK, META, prefix
 from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
 
@@ -43,7 +44,9 @@ class Feed:
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], options: BusOptions,
                  rejected: Callable[[str], None], lost: Callable[[str, int], None],
-                 announce: str, announced: Callable[[], None]) -> None:
+                 announce: str, announced: Callable[[], None],
+                 curve: Curve | None = None) -> None:
+        self._curve = curve
         self._ctx = ctx
         self._options = options
         self._rejected = rejected  # counts malformed broadcasts (dropped: nobody to answer)
@@ -83,9 +86,10 @@ class Feed:
 
         return cancel
 
-    def connect(self, endpoints: tuple[frozenset[str], frozenset[str]],
+    def connect(self, endpoints: tuple[dict[str, str], dict[str, str]],
                 wait: bool = False) -> None:
-        """Be connected to exactly these publishers' best-effort and reliable endpoints."""
+        """Be connected to exactly these publishers' best-effort and reliable endpoints
+        (each with its CURVE key, "" without CURVE)."""
         self._command("peers", endpoints, wait)
 
     def room(self) -> None:
@@ -116,11 +120,11 @@ class Feed:
                         self._last = {k: v for k, v in self._last.items() if k[1] != arg}
                 elif op == "peers" and isinstance(arg, tuple):
                     for sub, have, want in zip(subs, peers, arg, strict=True):
-                        _follow(sub, have, want)
+                        self._follow(sub, have, want)
                 elif op == "move" and isinstance(arg, str):
                     _quietly(subs[0].disconnect, self._announce)
                     self._announce = arg
-                    _quietly(subs[0].connect, arg)
+                    self._connect(subs[0], arg, self._curve.location if self._curve else b"")
                 elif op == "room":
                     self._retry()
             finally:
@@ -209,7 +213,7 @@ class Feed:
     def _run(self) -> None:
         lossy, reliable = self._socket(), self._socket()
         lossy.setsockopt(zmq.SUBSCRIBE, ANNOUNCE + b"\0")
-        _quietly(lossy.connect, self._announce)
+        self._connect(lossy, self._announce, self._curve.location if self._curve else b"")
         peers: tuple[set[str], set[str]] = (set(), set())
         poller = zmq.Poller()
         for sock in (lossy, reliable, self._waker.rx):
@@ -249,22 +253,27 @@ class Feed:
             except Exception:  # never let one message end the subscriber thread
                 log.exception("broadcast delivery failed")
 
+    def _follow(self, sub: zmq.Socket[bytes], have: set[str], want: dict[str, str]) -> None:
+        """Connect ``sub`` to the endpoints of ``want`` it lacks, disconnect the others."""
+        for gone in have - want.keys():
+            _quietly(sub.disconnect, gone)
+        for new in want.keys() - have:
+            self._connect(sub, new, want[new].encode())
+        have.clear()
+        have.update(want)
+
+    def _connect(self, sub: zmq.Socket[bytes], endpoint: str, key: bytes) -> None:
+        """Connect, as a CURVE client of ``key`` when the bus uses CURVE."""
+        if self._curve is not None:
+            self._curve.client(sub, key)
+        _quietly(sub.connect, endpoint)
+
     def close(self) -> None:
         """Stop the receiving thread and close its socket."""
         self._stopped.set()
         self._waker.wake()
         self._thread.join(timeout=5.0)
         self._waker.close()
-
-
-def _follow(sub: zmq.Socket[bytes], have: set[str], want: frozenset[str]) -> None:
-    """Connect ``sub`` to the endpoints of ``want`` it lacks, disconnect the others."""
-    for gone in have - want:
-        _quietly(sub.disconnect, gone)
-    for new in want - have:
-        _quietly(sub.connect, new)
-    have.clear()
-    have.update(want)
 
 
 def _quietly(call: Callable[[str], object], endpoint: str) -> None:

@@ -20,13 +20,15 @@ from robosoa.errors import PublishTimeout, RobosoaError
 from robosoa.location import PUBLISHERS, ServiceInfo
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions, Sink
+from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import RELIABLE, Outlet
 from robosoa.transports.zmq_pubsub import Feed
 
 log = logging.getLogger("robosoa.zmq")
 
 Location = Callable[[dict[str, Any], float], dict[str, Any]]
-Found = tuple[frozenset[str], frozenset[str]]  # publishers' PUB and reliable XPUB endpoints
+Peers = dict[str, str]  # endpoint -> its CURVE key ("" without CURVE)
+Found = tuple[Peers, Peers]  # publishers' PUBs and reliable XPUBs
 LOOKUP_TIMEOUT = 1.0  # seconds one look-up of the publishers may take
 QUIET = 0.05  # seconds between two look-ups prompted by announcements (however many)
 
@@ -71,7 +73,8 @@ class Topics:
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str, options: BusOptions,
                  ask: Location, rejected: Callable[[str], None],
-                 lost: Callable[[str, int], None]) -> None:
+                 lost: Callable[[str, int], None], curve: Curve | None = None) -> None:
+        self._curve = curve
         self._ctx = ctx
         self._location = location
         self._options = options
@@ -82,7 +85,7 @@ class Topics:
         self._outlet: Outlet | None = None
         self._feed: Feed | None = None
         self._discovery: Discovery | None = None
-        self._found: Found = (frozenset(), frozenset())
+        self._found: Found = ({}, {})
         self.announce = ""
 
     def outlet(self) -> Outlet:
@@ -92,7 +95,7 @@ class Topics:
             return outlet
         with self._lock:
             if self._outlet is None:
-                self._outlet = Outlet(self._ctx, self._location, self._options)
+                self._outlet = Outlet(self._ctx, self._location, self._options, self._curve)
                 for info in self._outlet.infos:
                     self._register(info)
             return self._outlet
@@ -128,7 +131,7 @@ class Topics:
             with self._lock:
                 if self._feed is None:
                     self._feed = Feed(self._ctx, self._options, self._rejected, self._lost,
-                                      self.announce, self._announced)
+                                      self.announce, self._announced, self._curve)
                     self._discovery = Discovery(self._publishers, self._connected,
                                                 max(0.1, self._options.heartbeat))
                 feed = self._feed
@@ -172,15 +175,17 @@ class Topics:
         found = reply.get("services")
         if not isinstance(found, list):
             return None
-        lossy: set[str] = set()
-        reliable: set[str] = set()
+        lossy: Peers = {}
+        reliable: Peers = {}
         for data in found:
             try:
                 info = ServiceInfo.from_dict(data)
             except ValueError:
                 continue
-            (reliable if info.group == RELIABLE else lossy).add(info.endpoint)
-        return frozenset(lossy), frozenset(reliable)
+            if self._curve is not None and not info.key:
+                continue  # nobody to authenticate: not connected to
+            (reliable if info.group == RELIABLE else lossy)[info.endpoint] = info.key
+        return lossy, reliable
 
     def _connected(self, found: Found) -> None:
         self._found = found
@@ -191,7 +196,9 @@ class Topics:
         feed, outlet = self._feed, self._outlet
         if feed is not None:
             own = {outlet.endpoint, outlet.reliable_endpoint} if outlet is not None else set()
-            feed.connect((self._found[0] - own, self._found[1] - own), wait)
+            lossy, reliable = ({e: k for e, k in peers.items() if e not in own}
+                               for peers in self._found)
+            feed.connect((lossy, reliable), wait)
 
     def close(self) -> None:
         """Stop discovery and the feed, close the PUB."""
