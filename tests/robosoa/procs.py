@@ -157,11 +157,13 @@ def start_worker(url: str, name: str, role: str, idempotent: bool,
 
 TICKER = textwrap.dedent('''
     import os, signal, sys, threading, robosoa
-    url, topic, every = sys.argv[1], sys.argv[2], float(sys.argv[3])
-    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0)
+    url, topic, every, lifespan, advertise = sys.argv[1:6]
+    where = {"provider_bind": "tcp://127.0.0.1", "advertise_host": advertise} if advertise else {}
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0, **where)
+    every = float(every)
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    bus.advertise(topic)
+    bus.advertise(topic, robosoa.QoS(lifespan=float(lifespan)))
     print("ready", os.getpid(), flush=True)
     n = 0
     while not stop.wait(every):
@@ -171,8 +173,38 @@ TICKER = textwrap.dedent('''
 ''')
 
 
-def start_ticker(url: str, topic: str, every: float = 0.02) -> Proc:
-    """A process publishing ``{"n": 1, 2, ...}`` on ``topic`` every ``every`` seconds."""
-    proc = Proc([PYTHON, "-c", TICKER, url, topic, str(every)])
+def start_ticker(url: str, topic: str, every: float = 0.02, lifespan: float = 0.0,
+                 advertise: str = "") -> Proc:
+    """A process publishing ``{"n": 1, 2, ...}`` on ``topic`` every ``every`` seconds, with
+    that ``lifespan`` (0: none); ``advertise`` as for ``start_worker``."""
+    proc = Proc([PYTHON, "-c", TICKER, url, topic, str(every), str(lifespan), advertise])
+    proc.wait_line("ready")
+    return proc
+
+
+FLOODER = textwrap.dedent('''
+    import os, signal, sys, threading, robosoa
+    url, topic, count, size, go = sys.argv[1:6]
+    count, size = int(count), int(size)
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    bus.advertise(topic)
+    print("ready", flush=True)
+    while not os.path.exists(go) and not stop.wait(0.02):
+        bus.publish(topic + "-probe", {})
+    data = os.urandom(size)
+    for n in range(count):
+        bus.publish(topic, {"n": n, "data": data})
+    print("sent", count, flush=True)
+    stop.wait()
+    bus.close()
+''')
+
+
+def start_flooder(url: str, topic: str, count: int, size: int, go: str) -> Proc:
+    """A process that publishes probes on ``topic-probe`` until the file ``go`` exists, then
+    ``count`` messages of ``size`` random bytes on ``topic`` as fast as it can."""
+    proc = Proc([PYTHON, "-c", FLOODER, url, topic, str(count), str(size), go])
     proc.wait_line("ready")
     return proc

@@ -1,6 +1,9 @@
 """A TCP relay on the loopback for fault tests: forwards connections to a target and can cut
-them off without closing them (a partition: bytes are read and thrown away, as a network
-that drops packets would, so neither side sees an error), heal, and record the bytes it saw.
+them off without closing anything (a partition: the relay stops reading, accepting and
+writing, so bytes wait in the kernel's buffers and new connections in its backlog, as
+packets would be retransmitted across a cut link; neither side sees an error, only
+silence), heal (everything still pending then flows, as after a real outage), and record
+the bytes it saw.
 
 Network namespaces would need root; any 127.0.0.0/8 address works without: a provider that
 binds 127.0.0.1:P and advertises 127.0.0.2 is reached through a relay on 127.0.0.2:P.
@@ -39,7 +42,7 @@ class Relay:
         return f"tcp://{self.address[0]}:{self.address[1]}"
 
     def partition(self) -> None:
-        """Stop forwarding: every byte from now on is read and dropped, nothing is closed."""
+        """Stop forwarding and accepting; nothing is closed, nothing is read."""
         self._cut.set()
 
     def heal(self) -> None:
@@ -56,6 +59,9 @@ class Relay:
         selector.register(self._server, selectors.EVENT_READ, None)
         try:
             while not self._stop.is_set():
+                if self._cut.is_set():  # the link is down: nothing moves
+                    self._stop.wait(0.05)
+                    continue
                 for key, _ in selector.select(timeout=0.1):
                     if key.data is None:
                         self._accept(selector)
@@ -91,8 +97,6 @@ class Relay:
                 with contextlib.suppress(KeyError, ValueError):
                     selector.unregister(end)
                 end.close()
-            return
-        if self._cut.is_set():
             return
         if self._record:
             with self._lock:
