@@ -6,7 +6,7 @@ import itertools
 import json
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from enum import StrEnum
 from typing import Any, NamedTuple
 
@@ -111,7 +111,25 @@ def to_dict(msg: Message) -> Payload:
     return out
 
 
-_ENCODE = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+def _refuse(value: object) -> object:
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
+def _encoder() -> Callable[[object], str]:
+    """json's C encoder built once, compact, ASCII, NaN and Infinity refused, as
+    ``JSONEncoder(separators=(",", ":"), allow_nan=False).encode`` writes; without its
+    per-call set-up and its circular-reference check (a payload that contains itself ends in
+    RecursionError instead, refused all the same)."""
+    make = getattr(json.encoder, "c_make_encoder", None)
+    if make is None:  # not CPython's _json: the pure-Python encoder
+        return json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+    iterencode = make(None, _refuse, json.encoder.encode_basestring_ascii, None, ":", ",",
+                      False, False, False)
+    return lambda value: "".join(iterencode(value, 0))
+
+
+_ENCODE = _encoder()
+_BAD = (TypeError, ValueError, RecursionError)
 _FIELD_SET = frozenset(_FIELDS)
 _KINDS = {kind.value: kind for kind in Kind}
 _TEXT_FIELDS = ("service", "operation", "topic", "reply_to", "correlation_id", "id")
@@ -122,7 +140,7 @@ def encode(msg: Message) -> bytes:
     JSON-compatible (binary values need :func:`encode_frames`)."""
     try:
         return _ENCODE(to_dict(msg)).encode()
-    except (TypeError, ValueError) as exc:
+    except _BAD as exc:
         raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
 
 
@@ -139,7 +157,7 @@ def _frames(data: Payload, payload: Payload) -> Frames:
     """JSON of ``data`` (whose payload is ``payload``); binary values cut out on the slow path."""
     try:
         return [_ENCODE(data).encode()]
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:
         raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
     except TypeError as exc:  # maybe bytes, which json cannot write: cut them out
         problem = exc
@@ -149,7 +167,7 @@ def _frames(data: Payload, payload: Payload) -> Frames:
     data["payload"], data["blobs"] = plain, paths
     try:
         return [_ENCODE(data).encode(), *values]
-    except (TypeError, ValueError) as exc:
+    except _BAD as exc:
         raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
 
 
@@ -236,6 +254,11 @@ def check_payload(payload: Mapping[str, Any] | None) -> Payload:
     """Coerce a caller's payload to a plain dict, refusing non-mappings and non-str keys."""
     if payload is None:
         return {}
+    if type(payload) is dict:  # the common case, without the ABC check
+        for key in payload:
+            if type(key) is not str:
+                raise InvalidMessage("payload keys must be strings")
+        return payload.copy()
     if not isinstance(payload, Mapping):
         raise InvalidMessage(f"payload must be a mapping, not {type(payload).__name__}")
     for key in payload:

@@ -26,6 +26,7 @@ log = logging.getLogger("robosoa.subscription")
 
 Callback = Callable[[Message], None]
 Held = tuple[Message, int, float]  # message, its size in bytes, stale from (epoch s)
+_NEVER = math.inf
 
 
 class Subscription:
@@ -42,7 +43,11 @@ class Subscription:
         self._counter = counter
         self._on_room = on_room  # told when a refused (reliable) message may be offered again
         self._refused = False
-        self._cond = threading.Condition()
+        self._max_bytes = qos.max_bytes
+        self._lifespan = qos.lifespan
+        self._reliable = qos.reliable
+        self._lock = threading.Lock()  # a plain lock: taken in C on the hot path
+        self._cond = threading.Condition(self._lock)  # only to wait and to wake
         self._closed = False
         self._cancel: Callable[[], None] | None = None
         self._callback = callback
@@ -68,8 +73,8 @@ class Subscription:
         return self._bytes
 
     def _stale_at(self, msg: Message, expires: float) -> float:
-        lifespan = self.qos.lifespan
-        own = msg.timestamp + lifespan if lifespan else math.inf
+        lifespan = self._lifespan
+        own = msg.timestamp + lifespan if lifespan else _NEVER
         return min(own, expires) if expires else own
 
     def sink(self, msg: Message, size: int = 0, expires: float = 0.0,
@@ -77,21 +82,22 @@ class Subscription:
         """Take a message from the transport without blocking; False when a reliable
         subscription has no room and the transport can ``hold`` the message back (offer it
         again after ``on_room``). Without ``hold`` (a best-effort stream) the oldest go."""
-        stale = self._stale_at(msg, expires)
-        with self._cond:
+        stale = self._stale_at(msg, expires) if expires or self._lifespan else _NEVER
+        with self._lock:
             if self._closed:
                 return True
-            if stale <= time.time():
+            if stale != _NEVER and stale <= time.time():
                 self._counter.drop("lifespan")
                 return True
             queue = self._queue
-            if hold and self.qos.reliable and queue and (
-                    len(queue) >= self._held or self._bytes + size > self.qos.max_bytes):
+            if hold and self._reliable and queue and (
+                    len(queue) >= self._held or self._bytes + size > self._max_bytes):
                 self._refused = True
                 return False
             queue.append((msg, size, stale))
             self._bytes += size
-            self._trim(queue)
+            if len(queue) > self._held or self._bytes > self._max_bytes:
+                self._trim(queue)
             if len(queue) == 1:  # readers only wait on an empty queue
                 self._cond.notify()
         return True
@@ -101,14 +107,14 @@ class Subscription:
         while len(queue) > self._held:
             self._bytes -= queue.popleft()[1]
             self._counter.drop("depth")
-        while self._bytes > self.qos.max_bytes and len(queue) > 1:
+        while self._bytes > self._max_bytes and len(queue) > 1:
             self._bytes -= queue.popleft()[1]
             self._counter.drop("bytes")
 
     def get(self, timeout: float | None = None) -> Message | None:
         """The next message that is not stale, or None on timeout or once closed."""
         deadline = None if timeout is None else time.monotonic() + timeout
-        with self._cond:
+        with self._lock:
             while True:
                 while not self._queue and not self._closed:
                     remaining = None if deadline is None else deadline - time.monotonic()
@@ -119,7 +125,7 @@ class Subscription:
                     return None
                 msg, size, stale = self._queue.popleft()
                 self._bytes -= size
-                if stale > time.time():
+                if stale == _NEVER or stale > time.time():
                     break
                 self._counter.drop("lifespan")  # went stale while it waited
             refused, self._refused = self._refused, False

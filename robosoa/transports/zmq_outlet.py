@@ -1,15 +1,16 @@
 """The publishing side of a bus over ZeroMQ: its own PUB socket, registered with the location
 service as a ``robosoa.pub`` entry so that subscribers connect to it directly.
 
-A bus registers two entries, its PUB and its reliable XPUB (group ``reliable``). A message is
-the channel frame, then the message's frames (``encode_broadcast``). The channel
-frame is ``t:NAME`` or ``e:NAME``, a NUL (so ZeroMQ's prefix matching of subscriptions is
-exact), and ``META``: this publisher's random id, the message's sequence number on that
-channel and its expiry time (0: none). Subscribers use the numbers to count what ZeroMQ's
-queues or a lost connection dropped on the way (reason ``lost``), and the expiry to drop
-stale messages (reason ``lifespan``). Every heartbeat a publisher also sends, on each
-best-effort channel it used since, a mark (expiry ``MARK``, an empty frame) with its last
-sequence number there, so losses at the end of a burst are counted too.
+A bus registers two entries, its PUB and its reliable XPUB (group ``reliable``). A message's
+first frame is ``t:NAME`` or ``e:NAME``, a NUL (so ZeroMQ's prefix matching of subscriptions
+is exact), ``META`` (this publisher's random id, the message's sequence number on that
+channel and its expiry time, 0: none) and the message's JSON; its binary frames follow
+(``encode_broadcast``). One frame, not two: a send and a receive less per message.
+Subscribers use the numbers to count what ZeroMQ's queues or a lost connection dropped on the
+way (reason ``lost``), and the expiry to drop stale messages (reason ``lifespan``). Every
+heartbeat a publisher also sends, on each best-effort channel it used since, a mark (expiry
+``MARK``, no JSON) with its last sequence number there, so losses at the end of a burst are
+counted too.
 """
 
 from __future__ import annotations
@@ -119,8 +120,11 @@ class Outlet:
                 self._marked.clear()
             self._seq[channel] = seq
             try:
-                self._pub.send(head + META.pack(self.id, seq, expires), _MORE_NOBLOCK)
-                send_frames(self._pub, frames, _NOBLOCK)
+                if len(frames) == 1:
+                    self._pub.send(head + META.pack(self.id, seq, expires) + frames[0], _NOBLOCK)
+                else:
+                    send_frames(self._pub, [head + META.pack(self.id, seq, expires) + frames[0],
+                                            *frames[1:]], _NOBLOCK)
             except zmq.Again:  # a PUB drops instead; kept for safety
                 pass
 
@@ -131,12 +135,11 @@ class Outlet:
         deadline = time.monotonic() + block
         pause = 0.0005
         with self._reliable_lock:
-            head = self._head(channel, expires)
+            first = [self._head(channel, expires) + frames[0], *frames[1:]]
             while True:
                 self._drain()
                 try:
-                    self._reliable.send(head, _MORE_NOBLOCK)
-                    send_frames(self._reliable, frames, _NOBLOCK)
+                    send_frames(self._reliable, first, _NOBLOCK)
                     return True
                 except zmq.Again:
                     if time.monotonic() >= deadline:
@@ -153,9 +156,7 @@ class Outlet:
             for channel, seq in news:
                 self._marked[channel] = seq
                 with contextlib.suppress(zmq.Again):
-                    self._pub.send(prefix(channel) + META.pack(self.id, seq, MARK),
-                                   _MORE_NOBLOCK)
-                    self._pub.send(b"", _NOBLOCK)
+                    self._pub.send(prefix(channel) + META.pack(self.id, seq, MARK), _NOBLOCK)
         with self._reliable_lock:
             self._drain()
 

@@ -160,33 +160,40 @@ class Feed:
         only for messages of the reliable socket, ``hold``)."""
         head = frames[0]
         cut = head.find(b"\0")
-        if cut < 0 or len(frames) < 2:
-            self._rejected("broadcast")
-            return True
         channel = head[:cut]
         if channel == ANNOUNCE:
             self._announced()
             return True
+        if cut < 0 or len(head) < cut + 1 + META.size:
+            self._rejected("broadcast")
+            return True
         sinks = self._sinks.get(channel)
         if sinks is None:
             return True
-        expires = 0.0
-        if len(head) - cut - 1 == META.size:
-            publisher, seq, expires = META.unpack_from(head, cut + 1)
-            self._sequence(publisher, channel, seq, expires == MARK)
-            if expires == MARK:
-                return True
+        publisher, seq, expires = META.unpack_from(head, cut + 1)
+        self._sequence(publisher, channel, seq, expires == MARK)
+        if expires == MARK:
+            return True
+        body = head[cut + 1 + META.size:]
         try:
-            msg = decode_frames(frames[1:], self._options.max_message, self._options.max_depth)
+            msg = decode_frames([body, *frames[1:]] if len(frames) > 1 else [body],
+                                self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
             return True
-        size = sum(map(len, frames))
-        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
-        if refused:
-            self._held = (msg, size, expires, refused)
-        return not refused
+        size = len(head) if len(frames) == 1 else sum(map(len, frames))
+        refused: tuple[Sink, ...]
+        if len(sinks) == 1:
+            if sinks[0](msg, size, expires, hold):
+                return True
+            refused = sinks
+        else:
+            refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
+            if not refused:
+                return True
+        self._held = (msg, size, expires, refused)
+        return False
 
     def _sequence(self, publisher: int, channel: bytes, seq: int, mark: bool) -> None:
         """Count the messages of ``publisher`` on ``channel`` that were skipped (up to its
