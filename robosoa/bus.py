@@ -6,27 +6,24 @@ import logging
 import os
 import socket
 import threading
-import time
 import uuid
 from collections.abc import Mapping
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from types import TracebackType
 from typing import Any
 
-from robosoa.channel import Channel, call_instance
+from robosoa.calls import Calls
+from robosoa.channel import Channel
 from robosoa.directory import Directory
 from robosoa.dispatch import Builtin, Dispatcher, Handler, Validator
 from robosoa.errors import (
     BusClosed,
-    ProviderLost,
-    RequestTimeout,
     RobosoaError,
     ServiceNotFound,
 )
 from robosoa.location import BUS_ENTRY, INTERNAL, PATTERNS, ServiceInfo
 from robosoa.message import (
     Kind,
-    Message,
     Payload,
     check_payload,
     event_channel,
@@ -35,15 +32,14 @@ from robosoa.message import (
 from robosoa.provider import ERROR_EVENT, ProviderHandle
 from robosoa.qos import QoS
 from robosoa.registrar import Registrar
-from robosoa.stats import Counter, ServiceFigures
+from robosoa.stats import ServiceFigures
 from robosoa.streams import Streams
 from robosoa.subscription import Callback, Subscription
-from robosoa.transports.base import BusOptions, Lost, ProtocolAdapter, Unreachable
+from robosoa.transports.base import BusOptions, ProtocolAdapter
 
 log = logging.getLogger("robosoa.bus")
 
 TARGETS = ("one", "group", "all")
-ASYNC_WORKERS = 8  # asynchronous requests run on this many threads per bus
 
 
 class Bus:
@@ -55,12 +51,10 @@ class Bus:
         self.stats_book = adapter.stats_book
         self.directory = Directory(adapter, self.options)
         self.streams = Streams(adapter, self.options, self._expose)
-        self._consumers: dict[str, Counter] = {}
+        self.calls = Calls(adapter, self.options, self.directory)
         self._lock = threading.Lock()
         self._exposed = False
         self._closed = False
-        self._executor: ThreadPoolExecutor | None = None
-        self._pending = 0
         adapter.configure()
         try:
             adapter.connect()
@@ -131,7 +125,7 @@ class Bus:
         """Block until ``count`` instances of the service are registered; ServiceNotFound else."""
         return self.directory.wait_for(name, timeout, version, count)
 
-    # --- request / response -------------------------------------------------------------
+    # --- request / response, one-way (robosoa.calls) -----------------------------------
     def request(self, service: str, operation: str, payload: Mapping[str, Any] | None = None,
                 timeout: float = 5.0, version: str | None = None,
                 idempotent: bool | None = None) -> Payload:
@@ -143,74 +137,8 @@ class Bus:
         registered the operation), else ProviderLost is raised at once.
         """
         self._check_open()
-        body = check_payload(payload)
-        deadline = time.monotonic() + timeout
-        tried: set[str] = set()
-        failed: set[str] = set()
-        fresh = False
-        while True:
-            found = self._lookup(service, version, fresh, deadline)
-            if not found and not tried:
-                detail = f"no provider in version range {version!r}" if version else ""
-                raise ServiceNotFound(service, detail)
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                self.stats_book.counter(service, "consumer").record(None, error=True)
-                raise RequestTimeout(service, operation, timeout, _tried(failed))
-            left = [i for i in found if i.instance not in tried] if tried else found
-            if not left:  # every instance failed: wait a little and look again
-                time.sleep(min(0.05, remaining))
-                tried.clear()
-                fresh = True
-                continue
-            info = self.directory.pick(left)
-            try:
-                return self._call_instance(info, operation, body, remaining, timeout)
-            except (Unreachable, Lost) as exc:
-                self._failed(info, operation, exc, idempotent)
-                tried.add(info.instance)
-                failed.add(info.instance)
-                fresh = True
-
-    def _failed(self, info: ServiceInfo, operation: str, exc: RobosoaError,
-                idempotent: bool | None) -> None:
-        """An instance failed a call: pass it over for a while; a request it may have run
-        is tried again elsewhere only when idempotent (else ProviderLost)."""
-        self.directory.suspect(info)
-        counter = self.stats_book.counter(info.name, "consumer")
-        if isinstance(exc, Unreachable):  # never handed over: safe to try another instance
-            counter.drop("unreachable")
-            return
-        retry = operation in info.idempotent if idempotent is None else idempotent
-        if not retry:
-            counter.record(None, error=True)
-            why = f"not retried: operation {operation!r} is not idempotent"
-            raise ProviderLost(info.name, operation, info.instance, why) from None
-        counter.fail()
-        log.info("request retried on another instance", extra={
-            "service": info.name, "instance": info.instance, "reason": str(exc)})
-
-    def _lookup(self, service: str, version: str | None, fresh: bool,
-                deadline: float) -> list[ServiceInfo]:
-        """Candidates within the caller's deadline; a location failure names the service."""
-        try:
-            return self.directory.candidates(service, version, fresh,
-                                             max(0.01, deadline - time.monotonic()))
-        except BusClosed:
-            raise
-        except RobosoaError as exc:
-            raise ServiceNotFound(service, str(exc)) from None
-
-    def _call_instance(self, info: ServiceInfo, operation: str, body: Payload, remaining: float,
-                       timeout: float | None = None) -> Payload:
-        counter = self._consumers.get(info.name)
-        if counter is None:
-            counter = self._consumers[info.name] = self.stats_book.counter(info.name, "consumer")
-        try:
-            return call_instance(self.adapter, counter, info, operation, body, remaining, timeout)
-        except RequestTimeout:
-            self.directory.forget(info.name)
-            raise
+        return self.calls.request(service, operation, check_payload(payload), timeout,
+                                  version, idempotent)
 
     def request_async(self, service: str, operation: str,
                       payload: Mapping[str, Any] | None = None, timeout: float = 5.0,
@@ -218,32 +146,9 @@ class Bus:
                       idempotent: bool | None = None) -> Future[Payload]:
         """Asynchronous request/response: a Future resolved with the reply or the error."""
         self._check_open()
-        body = check_payload(payload)
-        with self._lock:
-            if self._executor is None:
-                self._executor = ThreadPoolExecutor(ASYNC_WORKERS,
-                                                    thread_name_prefix="robosoa-async")
-            executor = self._executor
-            full = self._pending >= self.options.queue_size
-            if not full:
-                self._pending += 1
-        if full:  # bounded: refuse rather than queue without limit
-            self.stats_book.counter(service, "consumer").drop("queue")
-            refused: Future[Payload] = Future()
-            refused.set_exception(RobosoaError(
-                f"request {service}.{operation} refused: {self.options.queue_size} "
-                "asynchronous requests already pending"))
-            return refused
-        future = executor.submit(self.request, service, operation, body, timeout, version,
-                                 idempotent)
-        future.add_done_callback(self._async_done)
-        return future
+        return self.calls.request_async(service, operation, check_payload(payload), timeout,
+                                        version, idempotent)
 
-    def _async_done(self, _future: Future[Payload]) -> None:
-        with self._lock:
-            self._pending -= 1
-
-    # --- one-way, point-to-point --------------------------------------------------------
     def send(self, service: str, operation: str, payload: Mapping[str, Any] | None = None,
              to: str = "one", group: str | None = None, version: str | None = None) -> int:
         """Fire-and-forget to one instance, every instance of a group, or all; returns how
@@ -253,27 +158,7 @@ class Bus:
             raise ValueError(f"to must be one of {', '.join(TARGETS)}, not {to!r}")
         if to == "group" and group is None:
             raise ValueError("to='group' needs group=")
-        msg = Message(Kind.ONEWAY, service=service, operation=operation,
-                      payload=check_payload(payload), context={"operation": operation})
-        found = self._lookup(service, version, False, time.monotonic() + 5.0)
-        if to == "group":
-            found = [i for i in found if i.group == group]
-        if not found:
-            raise ServiceNotFound(service, f"no instance in group {group!r}" if group else "")
-        targets = [self.directory.pick(found)] if to == "one" else found
-        counter = self.stats_book.counter(service, "sender")
-        delivered = 0
-        for info in targets:
-            try:
-                self.adapter.post(info.endpoint, msg)
-                delivered += 1
-                counter.record(None)
-            except Unreachable:
-                counter.drop("unreachable")
-                self.directory.forget(service)
-        if to == "one" and not delivered and len(found) > 1:
-            return self.send(service, operation, payload, to, group, version)
-        return delivered
+        return self.calls.send(service, operation, check_payload(payload), to, group, version)
 
     def channel(self, service: str, instance: str | None = None,
                 version: str | None = None) -> Channel:
@@ -283,7 +168,7 @@ class Bus:
             found = [i for i in found if i.instance == instance]
         if not found:
             raise ServiceNotFound(service, f"no instance {instance!r}" if instance else "")
-        return Channel(self._call_instance, self.adapter, found[0])
+        return Channel(self.calls.call_instance, self.adapter, found[0])
 
     # --- publish / subscribe, events (robosoa.streams) -------------------------------------
     def advertise(self, topic: str, qos: QoS | None = None, event: bool = False) -> None:
@@ -364,11 +249,8 @@ class Bus:
         self.registrar.stop()
         for handle in self.providers:
             handle.close()
-        with self._lock:
-            executor, self._executor = self._executor, None
         self.streams.close()
-        if executor is not None:
-            executor.shutdown(wait=False, cancel_futures=True)
+        self.calls.close()
         self.adapter.shutdown()  # in-flight calls (heartbeats too) end within one slice
         self.registrar.join()
 
@@ -382,8 +264,4 @@ class Bus:
     def __repr__(self) -> str:
         return f"<robosoa.Bus {self.adapter.address}>"
 
-
-def _tried(instances: set[str]) -> str:
-    """The detail of a timeout after failed instances."""
-    return f"no instance answered (failed: {', '.join(sorted(instances))})" if instances else ""
 
