@@ -16,7 +16,8 @@ from robosoa.errors import BusClosed, RobosoaError, ServiceNotFound
 from robosoa.location import INTERNAL, ServiceInfo, select
 from robosoa.transports.base import BusOptions, ProtocolAdapter
 
-Selection = tuple[float, list[ServiceInfo]]
+Selection = tuple[float, list[ServiceInfo]]  # when looked up, what came back
+Chosen = tuple[list[ServiceInfo], list[ServiceInfo]]  # what came back, those in the range
 log = logging.getLogger("robosoa.bus")
 SUSPECT = 5.0  # seconds an instance that failed a call is passed over while others exist
 STALE_LOOKUP = 0.25  # seconds a refresh may take when known routes can be used instead
@@ -42,7 +43,7 @@ class Directory:
         self._adapter = adapter
         self._options = options
         self._cache: dict[str, Selection] = {}
-        self._chosen: dict[tuple[str, str | None], Selection] = {}
+        self._chosen: dict[tuple[str, str | None], Chosen] = {}
         self._suspects: dict[str, float] = {}  # instance -> until (monotonic)
         self._away_until = 0.0  # the location service failed: use known routes until then
         self._turn = itertools.count()
@@ -90,7 +91,11 @@ class Directory:
         if cached is None:
             return self.services(name, version, timeout)
         usable = not fresh and now - cached[0] < self._options.lookup_cache
-        if not (usable or now < self._away_until):
+        if usable:
+            chosen = self._chosen_from(name, version, cached)
+            if chosen:  # none in the range yet: ask again, as the cache may be behind
+                return chosen
+        if now >= self._away_until:
             try:
                 return self.services(name, version, min(timeout or STALE_LOOKUP, STALE_LOOKUP))
             except BusClosed:
@@ -103,11 +108,12 @@ class Directory:
         return self._chosen_from(name, version, cached)
 
     def _chosen_from(self, name: str, version: str | None, cached: Selection) -> list[ServiceInfo]:
-        """The entries of a cached lookup within the version range (memoised per lookup)."""
+        """The entries of a cached lookup within the version range (memoised per lookup:
+        per list of entries the location service sent)."""
         key = (name, version)
         chosen = self._chosen.get(key)
-        if chosen is None or chosen[0] != cached[0]:
-            chosen = (cached[0], select(cached[1], name, version))
+        if chosen is None or chosen[0] is not cached[1]:
+            chosen = (cached[1], select(cached[1], name, version))
             with self._lock:
                 self._chosen[key] = chosen
         return chosen[1]
