@@ -15,6 +15,8 @@ from robosoa.channel import Channel
 from robosoa.errors import (
     BusClosed,
     InvalidMessage,
+    ProviderLost,
+    PublishTimeout,
     RemoteError,
     RemoteInvalidMessage,
     RequestTimeout,
@@ -24,6 +26,7 @@ from robosoa.errors import (
 from robosoa.location import ServiceInfo
 from robosoa.message import Kind, Message
 from robosoa.provider import ERROR_EVENT, ProviderHandle
+from robosoa.qos import QoS
 from robosoa.router import Router, RuleError
 from robosoa.stats import ServiceFigures
 from robosoa.subscription import Subscription
@@ -55,7 +58,8 @@ def bridge(source: Bus, target: Bus, services: tuple[str, ...] | list[str] = (),
 
 __all__ = [
     "ERROR_EVENT", "Bridge", "Bus", "BusClosed", "BusOptions", "Channel", "InvalidMessage",
-    "Kind", "Message", "ProviderHandle", "RemoteError", "RemoteInvalidMessage",
+    "Kind", "Message", "ProviderHandle", "ProviderLost", "PublishTimeout", "QoS", "RemoteError",
+    "RemoteInvalidMessage",
     "RequestTimeout", "RobosoaError", "Router", "RuleError", "ServiceFigures", "ServiceInfo",
     "ServiceNotFound", "Subscription", "bridge", "connect",
 ]

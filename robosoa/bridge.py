@@ -61,7 +61,8 @@ class Bridge:
 
         self.handles.append(self.target.provide(name, forward, version=best.version,
                                                 operations=best.operations,
-                                                pattern=best.pattern, group=best.group))
+                                                pattern=best.pattern, group=best.group,
+                                                idempotent=best.idempotent))
 
     def _topic(self, src: Bus, dst: Bus, name: str, event: bool) -> None:
         mark = f"{self.id}:{id(dst)}"

@@ -2,43 +2,44 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import socket
 import threading
-import time
 import uuid
 from collections.abc import Mapping
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future
 from types import TracebackType
 from typing import Any
 
-from robosoa.channel import Channel, call_instance
+from robosoa.calls import Calls
+from robosoa.channel import Channel
 from robosoa.directory import Directory
 from robosoa.dispatch import Builtin, Dispatcher, Handler, Validator
 from robosoa.errors import (
     BusClosed,
-    RequestTimeout,
     RobosoaError,
     ServiceNotFound,
 )
-from robosoa.location import PATTERNS, ServiceInfo
+from robosoa.location import BUS_ENTRY, INTERNAL, PATTERNS, ServiceInfo
 from robosoa.message import (
     Kind,
-    Message,
     Payload,
     check_payload,
-    encode_broadcast,
     event_channel,
     topic_channel,
 )
 from robosoa.provider import ERROR_EVENT, ProviderHandle
+from robosoa.qos import QoS
 from robosoa.registrar import Registrar
-from robosoa.stats import Counter, ServiceFigures
+from robosoa.stats import ServiceFigures
+from robosoa.streams import Streams
 from robosoa.subscription import Callback, Subscription
-from robosoa.transports.base import BusOptions, ProtocolAdapter, Unreachable
+from robosoa.transports.base import BusOptions, ProtocolAdapter
+
+log = logging.getLogger("robosoa.bus")
 
 TARGETS = ("one", "group", "all")
-ASYNC_WORKERS = 8  # asynchronous requests run on this many threads per bus
 
 
 class Bus:
@@ -48,14 +49,12 @@ class Bus:
         self.adapter = adapter
         self.options = options or adapter.options
         self.stats_book = adapter.stats_book
-        self._subscriptions: list[Subscription] = []
         self.directory = Directory(adapter, self.options)
-        self._consumers: dict[str, Counter] = {}
-        self._publishers: dict[str, Counter] = {}
+        self.streams = Streams(adapter, self.options, self._expose)
+        self.calls = Calls(adapter, self.options, self.directory)
         self._lock = threading.Lock()
+        self._exposed = False
         self._closed = False
-        self._executor: ThreadPoolExecutor | None = None
-        self._pending = 0
         adapter.configure()
         try:
             adapter.connect()
@@ -67,11 +66,22 @@ class Bus:
     # --- providers -----------------------------------------------------------------
     def provide(self, name: str, handler: Handler, version: str = "1.0.0",
                 operations: tuple[str, ...] | list[str] = (), pattern: str = "request-response",
-                group: str | None = None, validator: Validator | None = None) -> ProviderHandle:
-        """Offer a service; the handler runs on the instance's own thread, one message at a time."""
+                group: str | None = None, validator: Validator | None = None,
+                idempotent: tuple[str, ...] | list[str] = ()) -> ProviderHandle:
+        """Offer a service; the handler runs on the instance's own thread, one message at a
+        time. ``idempotent`` names the operations a consumer may retry on another instance
+        when this one is lost mid-request."""
         self._check_open()
         if pattern not in PATTERNS:
             raise ValueError(f"unknown pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
+        if name.startswith(INTERNAL):
+            raise ValueError(f"service names starting with {INTERNAL!r} are the runtime's own")
+        return self._offer(name, handler, version, tuple(operations), pattern, group,
+                           validator, tuple(idempotent))
+
+    def _offer(self, name: str, handler: Handler, version: str, operations: tuple[str, ...],
+               pattern: str, group: str | None, validator: Validator | None,
+               idempotent: tuple[str, ...]) -> ProviderHandle:
         instance = f"{name}-{socket.gethostname()}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
         counter = self.stats_book.counter(name, "provider")
         builtins: dict[str, Builtin] = {
@@ -79,15 +89,30 @@ class Bus:
             "_stats": lambda _m: {"instance": instance,
                                   "figures": [f.to_dict() for f in self.stats()]},
         }
-        dispatcher = Dispatcher(name, handler, tuple(operations), validator, builtins)
+        dispatcher = Dispatcher(name, handler, operations, validator, builtins)
+        unknown = set(idempotent) - set(dispatcher.operations) if dispatcher.operations else ()
+        if unknown:
+            raise ValueError(f"idempotent names unknown operations: {', '.join(sorted(unknown))}")
         inbox = self.adapter.open_inbox(instance)
         info = ServiceInfo(name, version, dispatcher.operations, pattern, inbox.endpoint,
-                           instance, group, socket.gethostname(), os.getpid(), self.options.ttl)
+                           instance, group, socket.gethostname(), os.getpid(), self.options.ttl,
+                           idempotent=idempotent, key=inbox.key)
         handle = ProviderHandle(info, dispatcher, inbox, counter,
                                 lambda event: self.emit(ERROR_EVENT, event),
-                                self.registrar.remove)
+                                self.registrar.remove, self.options.deadline_slack)
         self.registrar.add(handle)
         return handle
+
+    def _expose(self) -> None:
+        """Once this bus publishes or listens: a hidden ``robosoa.bus`` instance answering
+        ``_ping`` and ``_stats``, so ``robosoa stats`` shows its subscribers' and publishers'
+        counters even when it provides no service."""
+        with self._lock:
+            if self._exposed:
+                return
+            self._exposed = True
+        self._offer(BUS_ENTRY, {}, "1.0.0", ("_ping", "_stats"), "request-response", None,
+                    None, ())
 
     # --- lookup ----------------------------------------------------------------------
     def services(self, name: str | None = None, version: str | None = None) -> list[ServiceInfo]:
@@ -100,92 +125,30 @@ class Bus:
         """Block until ``count`` instances of the service are registered; ServiceNotFound else."""
         return self.directory.wait_for(name, timeout, version, count)
 
-    # --- request / response -------------------------------------------------------------
+    # --- request / response, one-way (robosoa.calls) -----------------------------------
     def request(self, service: str, operation: str, payload: Mapping[str, Any] | None = None,
-                timeout: float = 5.0, version: str | None = None) -> Payload:
-        """Blocking request/response; RequestTimeout, ServiceNotFound or RemoteError on failure."""
+                timeout: float = 5.0, version: str | None = None,
+                idempotent: bool | None = None) -> Payload:
+        """Blocking request/response; RequestTimeout, ServiceNotFound, RemoteError or
+        ProviderLost on failure.
+
+        If the provider's connection is lost after the request went out, the request is
+        tried on another instance when it is ``idempotent`` (default: as the provider
+        registered the operation), else ProviderLost is raised at once.
+        """
         self._check_open()
-        body = check_payload(payload)
-        deadline = time.monotonic() + timeout
-        excluded: set[str] = set()
-        fresh = False
-        while True:
-            found = self._lookup(service, version, fresh, deadline)
-            if excluded:
-                found = [i for i in found if i.instance not in excluded]
-            if not found and not excluded:
-                detail = f"no provider in version range {version!r}" if version else ""
-                raise ServiceNotFound(service, detail)
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                self.stats_book.counter(service, "consumer").record(None, error=True)
-                raise RequestTimeout(service, operation, timeout)
-            if not found:  # every instance refused: wait a little and look again
-                time.sleep(min(0.05, remaining))
-                excluded.clear()
-                fresh = True
-                continue
-            info = self.directory.pick(found)
-            try:
-                return self._call_instance(info, operation, body, remaining, timeout)
-            except Unreachable:  # gone, or its bounded inbox is full: counted, try another
-                self.stats_book.counter(service, "consumer").drop()
-                excluded.add(info.instance)
-                self.directory.forget(service)
-                fresh = True
-
-    def _lookup(self, service: str, version: str | None, fresh: bool,
-                deadline: float) -> list[ServiceInfo]:
-        """Candidates within the caller's deadline; a location failure names the service."""
-        try:
-            return self.directory.candidates(service, version, fresh,
-                                             max(0.01, deadline - time.monotonic()))
-        except BusClosed:
-            raise
-        except RobosoaError as exc:
-            raise ServiceNotFound(service, str(exc)) from None
-
-    def _call_instance(self, info: ServiceInfo, operation: str, body: Payload, remaining: float,
-                       timeout: float | None = None) -> Payload:
-        counter = self._consumers.get(info.name)
-        if counter is None:
-            counter = self._consumers[info.name] = self.stats_book.counter(info.name, "consumer")
-        try:
-            return call_instance(self.adapter, counter, info, operation, body, remaining, timeout)
-        except RequestTimeout:
-            self.directory.forget(info.name)
-            raise
+        return self.calls.request(service, operation, check_payload(payload), timeout,
+                                  version, idempotent)
 
     def request_async(self, service: str, operation: str,
                       payload: Mapping[str, Any] | None = None, timeout: float = 5.0,
-                      version: str | None = None) -> Future[Payload]:
+                      version: str | None = None,
+                      idempotent: bool | None = None) -> Future[Payload]:
         """Asynchronous request/response: a Future resolved with the reply or the error."""
         self._check_open()
-        body = check_payload(payload)
-        with self._lock:
-            if self._executor is None:
-                self._executor = ThreadPoolExecutor(ASYNC_WORKERS,
-                                                    thread_name_prefix="robosoa-async")
-            executor = self._executor
-            full = self._pending >= self.options.queue_size
-            if not full:
-                self._pending += 1
-        if full:  # bounded: refuse rather than queue without limit
-            self.stats_book.counter(service, "consumer").drop()
-            refused: Future[Payload] = Future()
-            refused.set_exception(RobosoaError(
-                f"request {service}.{operation} refused: {self.options.queue_size} "
-                "asynchronous requests already pending"))
-            return refused
-        future = executor.submit(self.request, service, operation, body, timeout, version)
-        future.add_done_callback(self._async_done)
-        return future
+        return self.calls.request_async(service, operation, check_payload(payload), timeout,
+                                        version, idempotent)
 
-    def _async_done(self, _future: Future[Payload]) -> None:
-        with self._lock:
-            self._pending -= 1
-
-    # --- one-way, point-to-point --------------------------------------------------------
     def send(self, service: str, operation: str, payload: Mapping[str, Any] | None = None,
              to: str = "one", group: str | None = None, version: str | None = None) -> int:
         """Fire-and-forget to one instance, every instance of a group, or all; returns how
@@ -195,27 +158,7 @@ class Bus:
             raise ValueError(f"to must be one of {', '.join(TARGETS)}, not {to!r}")
         if to == "group" and group is None:
             raise ValueError("to='group' needs group=")
-        msg = Message(Kind.ONEWAY, service=service, operation=operation,
-                      payload=check_payload(payload), context={"operation": operation})
-        found = self._lookup(service, version, False, time.monotonic() + 5.0)
-        if to == "group":
-            found = [i for i in found if i.group == group]
-        if not found:
-            raise ServiceNotFound(service, f"no instance in group {group!r}" if group else "")
-        targets = [self.directory.pick(found)] if to == "one" else found
-        counter = self.stats_book.counter(service, "sender")
-        delivered = 0
-        for info in targets:
-            try:
-                self.adapter.post(info.endpoint, msg)
-                delivered += 1
-                counter.record(None)
-            except Unreachable:
-                counter.drop()
-                self.directory.forget(service)
-        if to == "one" and not delivered and len(found) > 1:
-            return self.send(service, operation, payload, to, group, version)
-        return delivered
+        return self.calls.send(service, operation, check_payload(payload), to, group, version)
 
     def channel(self, service: str, instance: str | None = None,
                 version: str | None = None) -> Channel:
@@ -225,56 +168,43 @@ class Bus:
             found = [i for i in found if i.instance == instance]
         if not found:
             raise ServiceNotFound(service, f"no instance {instance!r}" if instance else "")
-        return Channel(self._call_instance, self.adapter, found[0])
+        return Channel(self.calls.call_instance, self.adapter, found[0])
 
-    # --- publish / subscribe, events ------------------------------------------------------
+    # --- publish / subscribe, events (robosoa.streams) -------------------------------------
+    def advertise(self, topic: str, qos: QoS | None = None, event: bool = False) -> None:
+        """Declare that this bus publishes ``topic`` (an event with ``event=True``), with the
+        publishing side of ``qos``: ``lifespan`` travels with each message, ``reliable``
+        makes publish wait up to ``block`` for a full subscriber. On zmq it also binds and
+        registers the bus's PUB now, so subscribers have found it by the first message;
+        ``publish`` does that on its first call otherwise."""
+        self._check_open()
+        self.streams.advertise(event_channel(topic) if event else topic_channel(topic), qos)
+
     def publish(self, topic: str, payload: Mapping[str, Any] | None = None,
                 context: Mapping[str, Any] | None = None) -> None:
-        """Publish to every subscriber of ``topic``; never blocks (see fault behaviour)."""
+        """Publish to every subscriber of ``topic``; never blocks, unless the topic was
+        advertised reliable (then PublishTimeout after its ``block`` seconds)."""
         self._check_open()
-        raw = encode_broadcast(Kind.PUBLISH, topic, check_payload(payload),
-                               dict(context) if context else None)
-        self.adapter.publish(topic_channel(topic), raw)
-        counter = self._publishers.get(topic)
-        if counter is None:
-            counter = self._publishers[topic] = self.stats_book.counter(topic, "publisher")
-        counter.record(None)
+        self.streams.send(Kind.PUBLISH, topic, payload, context)
 
     def subscribe(self, topic: str, callback: Callback | None = None,
-                  queue_size: int | None = None) -> Subscription:
-        """Receive ``topic``: with a callback (own thread) or by iterating the subscription."""
-        return self._listen(topic_channel(topic), topic, callback, queue_size)
+                  queue_size: int | None = None, qos: QoS | None = None) -> Subscription:
+        """Receive ``topic``: with a callback (own thread) or by iterating the subscription.
+        ``qos`` bounds and shapes its queue (``queue_size`` overrides its depth)."""
+        self._check_open()
+        return self.streams.listen(topic_channel(topic), topic, callback, queue_size, qos)
 
     def emit(self, name: str, payload: Mapping[str, Any] | None = None,
              context: Mapping[str, Any] | None = None) -> None:
         """Emit a lightweight event (no service, no reply, no registration)."""
         self._check_open()
-        raw = encode_broadcast(Kind.EVENT, name, check_payload(payload),
-                               dict(context) if context else None)
-        self.adapter.publish(event_channel(name), raw)
+        self.streams.send(Kind.EVENT, name, payload, context)
 
     def on(self, name: str, callback: Callback | None = None,
-           queue_size: int | None = None) -> Subscription:
+           queue_size: int | None = None, qos: QoS | None = None) -> Subscription:
         """Listen to a lightweight event."""
-        return self._listen(event_channel(name), name, callback, queue_size)
-
-    def _listen(self, channel: str, name: str, callback: Callback | None,
-                queue_size: int | None) -> Subscription:
         self._check_open()
-        counter = self.stats_book.counter(name, "subscriber")
-        sub = Subscription(name, queue_size or self.options.queue_size, counter, callback)
-        cancel = self.adapter.subscribe(channel, sub.sink)
-
-        def detach() -> None:
-            with self._lock:
-                if sub in self._subscriptions:
-                    self._subscriptions.remove(sub)
-            cancel()
-
-        sub.attach(detach)
-        with self._lock:
-            self._subscriptions.append(sub)
-        return sub
+        return self.streams.listen(event_channel(name), name, callback, queue_size, qos)
 
     # --- infrastructure -------------------------------------------------------------------
     def federate(self, address: str) -> None:
@@ -319,13 +249,8 @@ class Bus:
         self.registrar.stop()
         for handle in self.providers:
             handle.close()
-        with self._lock:
-            subs = list(self._subscriptions)
-            executor, self._executor = self._executor, None
-        for sub in subs:
-            sub.close()
-        if executor is not None:
-            executor.shutdown(wait=False, cancel_futures=True)
+        self.streams.close()
+        self.calls.close()
         self.adapter.shutdown()  # in-flight calls (heartbeats too) end within one slice
         self.registrar.join()
 
@@ -338,4 +263,5 @@ class Bus:
 
     def __repr__(self) -> str:
         return f"<robosoa.Bus {self.adapter.address}>"
+
 

@@ -7,11 +7,17 @@ import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from robosoa.errors import RemoteError, RemoteInvalidMessage, RequestTimeout, ServiceNotFound
+from robosoa.errors import (
+    ProviderLost,
+    RemoteError,
+    RemoteInvalidMessage,
+    RequestTimeout,
+    ServiceNotFound,
+)
 from robosoa.location import ServiceInfo
 from robosoa.message import Kind, Message, Payload, check_payload
 from robosoa.stats import Counter
-from robosoa.transports.base import ProtocolAdapter, Unreachable
+from robosoa.transports.base import Lost, ProtocolAdapter, Unreachable
 
 CallInstance = Callable[[ServiceInfo, str, Payload, float, float | None], Payload]
 
@@ -28,9 +34,12 @@ def call_instance(adapter: ProtocolAdapter, counter: Counter, info: ServiceInfo,
                   body: Payload, remaining: float, timeout: float | None = None) -> Payload:
     """One request to one instance; the reply payload, or RequestTimeout / RemoteError.
 
-    Unreachable propagates so the caller can try another instance.
+    The consumer's deadline travels in the context (``deadline``: seconds since the epoch)
+    so the provider can drop work nobody waits for. Unreachable and Lost propagate so the
+    caller can try another instance.
     """
-    msg = Message(Kind.REQUEST, info.name, operation, "", body, {"operation": operation})
+    context = {"operation": operation, "deadline": time.time() + remaining}
+    msg = Message(Kind.REQUEST, info.name, operation, "", body, context)
     start = time.perf_counter()
     try:
         reply = adapter.call(info.endpoint, msg, remaining)
@@ -59,11 +68,15 @@ class Channel:
 
     def request(self, operation: str, payload: Mapping[str, Any] | None = None,
                 timeout: float = 5.0) -> Payload:
-        """Blocking request to this instance."""
+        """Blocking request to this instance; ProviderLost if its connection goes away
+        before the reply (a channel never fails over)."""
         try:
             return self._call(self.info, operation, check_payload(payload), timeout, timeout)
         except Unreachable as exc:
             raise self._gone(exc) from None
+        except Lost:
+            raise ProviderLost(self.info.name, operation, self.info.instance,
+                               "point-to-point channels do not fail over") from None
 
     def send(self, operation: str, payload: Mapping[str, Any] | None = None) -> None:
         """One-way message to this instance."""

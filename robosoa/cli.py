@@ -23,6 +23,17 @@ def _location(parser: argparse.ArgumentParser) -> None:
                         "(default: $ROBOSOA_LOCATION or tcp://127.0.0.1:5555)")
     parser.add_argument("--connect-timeout", type=float, default=2.0, metavar="S",
                         help="seconds to wait for the location service (default 2)")
+    _curve(parser)
+    parser.add_argument("--curve-location", metavar="FILE", help="the location service's "
+                        "public certificate (default $ROBOSOA_CURVE_LOCATION, else "
+                        "location.key in the allow folder)")
+
+
+def _curve(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--curve-secret", metavar="FILE", help="CURVE: this participant's "
+                        "certificate, NAME.key_secret (default $ROBOSOA_CURVE_SECRET)")
+    parser.add_argument("--curve-allow", metavar="DIR", help="CURVE: folder of the public "
+                        "certificates allowed on the bus (default $ROBOSOA_CURVE_ALLOW)")
 
 
 def _payload(parser: argparse.ArgumentParser) -> None:
@@ -52,17 +63,21 @@ def _location_limits(p: argparse.ArgumentParser) -> None:
 
 
 def _server_commands(sub: Any) -> None:
-    p = sub.add_parser("location", help="run a location service and message broker")
+    p = sub.add_parser("location", help="run a location service")
     p.add_argument("--bind", default="tcp://127.0.0.1:5555", help="location endpoint")
-    p.add_argument("--xsub", help="broker input endpoint (default: port+1 or PATH.xsub)")
-    p.add_argument("--xpub", help="broker output endpoint (default: port+2 or PATH.xpub)")
+    p.add_argument("--announce", help="endpoint of announcements of new publishers "
+                   "(default: port+1 or PATH.announce)")
     p.add_argument("--ttl", type=float, default=3.0, help="default entry TTL in seconds")
-    p.add_argument("--hwm", type=int, default=1000,
-                   help="broker queue per publisher and per subscriber (messages; then drops)")
     p.add_argument("--federate", action="append", metavar="ENDPOINT",
                    help="also answer for services of this location service (repeatable)")
     _location_limits(p)
+    _curve(p)
     p.set_defaults(run=commands.cmd_location)
+
+    p = sub.add_parser("keys", help="make CURVE certificates (NAME.key, NAME.key_secret)")
+    p.add_argument("folder", help="where to write them")
+    p.add_argument("names", nargs="+", metavar="NAME", help="one certificate per name")
+    p.set_defaults(run=commands.cmd_keys)
 
     p = sub.add_parser("route", help="run a content-based router from a rules file")
     p.add_argument("rules", help="rules file (.toml or .json)")

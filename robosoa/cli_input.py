@@ -70,7 +70,7 @@ def location_config(args: argparse.Namespace) -> LocationConfig:
     from robosoa.location import Limits
     from robosoa.transports.zmq_location import LocationConfig
 
-    binds = [("--bind", args.bind), ("--xsub", args.xsub), ("--xpub", args.xpub)]
+    binds = [("--bind", args.bind), ("--announce", args.announce)]
     binds += [("--federate", f) for f in args.federate or ()]
     for flag, address in binds:
         if address:
@@ -78,12 +78,13 @@ def location_config(args: argparse.Namespace) -> LocationConfig:
     for flag, value in [("--ttl", args.ttl), ("--max-ttl", args.max_ttl),
                         ("--federation-timeout", args.federation_timeout)]:
         positive(flag, value)
-    for flag, value in [("--hwm", args.hwm), ("--max-message", args.max_message),
+    for flag, value in [("--max-message", args.max_message),
                         ("--max-depth", args.max_depth), ("--max-entries", args.max_entries),
                         ("--max-per-peer", args.max_per_peer), ("--max-peers", args.max_peers)]:
         positive(flag, value, integer=True)
     limits = Limits(args.max_ttl, args.max_entries, args.max_per_peer, args.max_peers,
                     args.federation_timeout)
-    return LocationConfig(args.bind, args.xsub or "", args.xpub or "", args.ttl,
-                          tuple(args.federate or ()), args.hwm, args.max_message,
-                          args.max_depth, limits)
+    return LocationConfig(args.bind, args.announce or "", args.ttl,
+                          tuple(args.federate or ()), args.max_message,
+                          args.max_depth, limits, args.curve_secret or "",
+                          args.curve_allow or "")

@@ -16,10 +16,10 @@ from robosoa import connect
 from robosoa.bus import Bus
 from robosoa.cli_input import UsageError, endpoint, location_config, parse_pairs, positive
 from robosoa.errors import RobosoaError
-from robosoa.location import ServiceInfo
+from robosoa.location import BUS_ENTRY, ServiceInfo
 
 DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
-PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so the broker knows its subscribers
+PUBLISH_SETTLE = 0.3  # seconds a fresh publisher waits so that subscribers have joined it
 
 
 def location_url(text: str | None) -> str:
@@ -39,7 +39,20 @@ def _checked_url(flag: str, text: str | None) -> str:
 def _bus(args: argparse.Namespace) -> Bus:
     url = _checked_url("--location", args.location)
     positive("--connect-timeout", args.connect_timeout)
-    return connect(url, location_timeout=args.connect_timeout)
+    return connect(url, location_timeout=args.connect_timeout, **_curve_options(args))
+
+
+def _curve_options(args: argparse.Namespace) -> dict[str, str]:
+    """CURVE options of a client command (empty ones fall back to the environment)."""
+    from robosoa.transports import zmq_curve as curve
+
+    options = {"curve_secret": args.curve_secret or "", "curve_allow": args.curve_allow or "",
+               "curve_location": getattr(args, "curve_location", None) or ""}
+    try:
+        curve.load(options["curve_secret"], options["curve_allow"], options["curve_location"])
+    except RobosoaError as exc:
+        raise UsageError(str(exc)) from None
+    return options
 
 
 def cmd_location(args: argparse.Namespace) -> int:
@@ -49,13 +62,41 @@ def cmd_location(args: argparse.Namespace) -> int:
     config = location_config(args)
     try:
         server = LocationServer(config)
-    except RobosoaError as exc:  # cannot bind or federate: the flags are wrong
+    except RobosoaError as exc:  # cannot bind or federate, bad keys: the flags are wrong
         raise UsageError(str(exc)) from None
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: server.stop())
-    print(f"robosoa location service on {server.endpoint} "
-          f"xsub={server.broker[0]} xpub={server.broker[1]}", flush=True)
+    print(f"robosoa location service on {server.endpoint} announce={server.announce}",
+          flush=True)
+    print(_exposure(server.endpoint, server.curve is not None), file=sys.stderr, flush=True)
     server.serve()
+    return 0
+
+
+def _exposure(endpoint: str, secured: bool) -> str:
+    """What the location service's binding means for who can join the bus."""
+    host = endpoint.removeprefix("tcp://").rpartition(":")[0].strip("[]")
+    if secured:
+        return "robosoa: CURVE on: only the keys of the allow folder can join; traffic encrypted"
+    if endpoint.startswith("ipc://") or host in ("127.0.0.1", "::1", "localhost"):
+        return ("robosoa: bound to this machine only (loopback/ipc): other machines cannot "
+                "join; to open the bus, bind an address with --curve-secret and --curve-allow "
+                "(docs/runtime.md, Security)")
+    return (f"robosoa: WARNING: {endpoint} is reachable from the network WITHOUT "
+            "authentication or encryption: anyone who reaches it can register, publish and "
+            "call; use --curve-secret and --curve-allow (docs/runtime.md, Security)")
+
+
+def cmd_keys(args: argparse.Namespace) -> int:
+    """Write a CURVE certificate pair per name."""
+    from robosoa.transports import zmq_curve as curve
+
+    for name in args.names:
+        try:
+            public, secret = curve.create(args.folder, name)
+        except RobosoaError as exc:
+            raise UsageError(str(exc)) from None
+        print(f"{public}\n{secret}")
     return 0
 
 
@@ -101,6 +142,7 @@ def cmd_publish(args: argparse.Namespace) -> int:
     """Publish a topic message (``--count`` times, ``--interval`` apart)."""
     payload = parse_pairs(args.pairs, args.json)
     with _bus(args) as bus:
+        bus.advertise(args.topic)
         time.sleep(PUBLISH_SETTLE)
         for n in range(args.count):
             if n:
@@ -136,9 +178,11 @@ def cmd_stats(args: argparse.Namespace) -> int:
     """Ask every provider instance for its counters and print them."""
     rows: list[dict[str, Any]] = []
     with _bus(args) as bus:
-        if args.name is None:  # the location service's own counters come first
-            rows += _location_rows(bus, args.timeout)
-        for info in bus.services(args.name):
+        infos = bus.services(args.name)
+        if args.name is None:  # the location service's own counters come first, and the
+            rows += _location_rows(bus, args.timeout)  # buses that only publish or listen
+            infos += bus.services(BUS_ENTRY)
+        for info in infos:
             try:
                 reply = bus.channel(info.name, info.instance).request("_stats", {},
                                                                        timeout=args.timeout)
@@ -150,13 +194,15 @@ def cmd_stats(args: argparse.Namespace) -> int:
         print(json.dumps(rows, indent=2))
         return 0
     print(f"{'INSTANCE':40} {'ROLE':10} {'KEY':16} {'COUNT':>7} {'ERRORS':>6} {'DROPPED':>7} "
-          f"{'P50_MS':>8} {'P99_MS':>8}")
+          f"{'P50_MS':>8} {'P99_MS':>8} WHY DROPPED")
     for row in rows:
         if "error" in row:
             print(f"{row['instance']:40} unreachable: {row['error']}")
             continue
+        why = ",".join(f"{k}={v}" for k, v in sorted(row["drops"].items()))
         print(f"{row['instance']:40} {row['role']:10} {row['key']:16} {row['count']:7d} "
-              f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}")
+              f"{row['errors']:6d} {row['dropped']:7d} {row['p50_ms']:8.3f} {row['p99_ms']:8.3f}"
+              f" {why}".rstrip())
     return 0
 
 
@@ -175,14 +221,26 @@ _FIGURE_TYPES = {"key": (str,), "role": (str,), "count": (int,), "errors": (int,
                  "dropped": (int,), "p50_ms": (int, float), "p99_ms": (int, float)}
 
 
+def _drops(value: object) -> dict[str, int] | None:
+    """A peer's drop counts by reason, if well-formed (a few short names, whole numbers)."""
+    if value is None:
+        return {}
+    if not (isinstance(value, dict) and len(value) <= 32 and all(
+            isinstance(k, str) and len(k) <= 40 and type(n) is int for k, n in value.items())):
+        return None
+    return dict(value)
+
+
 def _figure_rows(instance: str, figures: object) -> list[dict[str, Any]]:
     """Rows of the figures a peer sent; a malformed answer becomes one error row."""
     rows: list[dict[str, Any]] = []
     for fig in figures if isinstance(figures, list) else [None]:
-        if not (isinstance(fig, dict) and all(
+        drops = _drops(fig.get("drops")) if isinstance(fig, dict) else None
+        if drops is None or not (isinstance(fig, dict) and all(
                 type(fig.get(k)) in types for k, types in _FIGURE_TYPES.items())):
             return [{"instance": instance, "error": "malformed statistics"}]
-        rows.append({"instance": instance, **{k: fig[k] for k in _FIGURE_TYPES}})
+        rows.append({"instance": instance, **{k: fig[k] for k in _FIGURE_TYPES},
+                     "drops": drops})
     return rows
 
 

@@ -1,4 +1,9 @@
-"""The consumer's view of the location service: lookups, a short cache, instance choice."""
+"""The consumer's view of the location service: lookups, a short cache, instance choice.
+
+The cache is also the consumer's memory of routes: while the location service cannot be
+reached, requests keep going to the instances it last named (minus those that failed), for
+as long as it stays away, instead of failing once the short cache runs out.
+"""
 
 from __future__ import annotations
 
@@ -7,12 +12,15 @@ import logging
 import threading
 import time
 
-from robosoa.errors import RobosoaError, ServiceNotFound
-from robosoa.location import ServiceInfo, select
+from robosoa.errors import BusClosed, RobosoaError, ServiceNotFound
+from robosoa.location import INTERNAL, ServiceInfo, select
 from robosoa.transports.base import BusOptions, ProtocolAdapter
 
-Selection = tuple[float, list[ServiceInfo]]
+Selection = tuple[float, list[ServiceInfo]]  # when looked up, what came back
+Chosen = tuple[list[ServiceInfo], list[ServiceInfo]]  # what came back, those in the range
 log = logging.getLogger("robosoa.bus")
+SUSPECT = 5.0  # seconds an instance that failed a call is passed over while others exist
+STALE_LOOKUP = 0.25  # seconds a refresh may take when known routes can be used instead
 
 
 def _entries(services: object) -> list[ServiceInfo]:
@@ -35,7 +43,9 @@ class Directory:
         self._adapter = adapter
         self._options = options
         self._cache: dict[str, Selection] = {}
-        self._chosen: dict[tuple[str, str | None], Selection] = {}
+        self._chosen: dict[tuple[str, str | None], Chosen] = {}
+        self._suspects: dict[str, float] = {}  # instance -> until (monotonic)
+        self._away_until = 0.0  # the location service failed: use known routes until then
         self._turn = itertools.count()
         self._lock = threading.Lock()
 
@@ -48,36 +58,85 @@ class Directory:
         if "error" in reply:
             raise RobosoaError(f"location service: {str(reply['error'])[:500]}")
         infos = _entries(reply.get("services"))
+        if self._away_until:
+            log.info("location service answers again", extra={"service": name})
+            self._away_until = 0.0
         if name is not None:
             with self._lock:
                 self._cache[name] = (time.monotonic(), infos)
+        else:  # a listing: the runtime's own entries (publishers' PUBs) are not services
+            infos = [i for i in infos if not i.name.startswith(INTERNAL)]
         return select(infos, name, version)
+
+    def suspect(self, info: ServiceInfo) -> None:
+        """``info`` failed a call (gone, or its connection lost): pass it over for a while."""
+        now = time.monotonic()
+        with self._lock:
+            self._suspects = {k: t for k, t in self._suspects.items() if t > now}
+            self._suspects[info.instance] = now + SUSPECT
+            self._stale(info.name)
+
+    def suspected(self, instance: str) -> bool:
+        """Whether ``instance`` failed a call within the last ``SUSPECT`` seconds."""
+        return self._suspects.get(instance, 0.0) > time.monotonic()
 
     def candidates(self, name: str, version: str | None, fresh: bool,
                    timeout: float | None = None) -> list[ServiceInfo]:
-        """Instances of ``name`` in the range, best first; from the cache unless ``fresh``."""
-        key = (name, version)
+        """Instances of ``name`` in the range, best first; from the cache unless ``fresh``
+        or older than ``lookup_cache``; from the last known routes while the location
+        service cannot be reached."""
         with self._lock:
             cached = self._cache.get(name)
-            chosen = self._chosen.get(key)
-        if not fresh and cached and time.monotonic() - cached[0] < self._options.lookup_cache:
-            if chosen is None or chosen[0] != cached[0]:
-                chosen = (cached[0], select(cached[1], name, version))
-                with self._lock:
-                    self._chosen[key] = chosen
-            if chosen[1]:
-                return chosen[1]
-        return self.services(name, version, timeout)
+        now = time.monotonic()
+        if cached is None:
+            return self.services(name, version, timeout)
+        usable = not fresh and now - cached[0] < self._options.lookup_cache
+        if usable:
+            chosen = self._chosen_from(name, version, cached)
+            if chosen:  # none in the range yet: ask again, as the cache may be behind
+                return chosen
+        if now >= self._away_until:
+            try:
+                return self.services(name, version, min(timeout or STALE_LOOKUP, STALE_LOOKUP))
+            except BusClosed:
+                raise
+            except RobosoaError as exc:  # keep using what it told us last
+                if not self._away_until:
+                    log.warning("location service unreachable: using known routes",
+                                extra={"service": name, "reason": str(exc)})
+                self._away_until = time.monotonic() + max(0.1, self._options.heartbeat)
+        return self._chosen_from(name, version, cached)
+
+    def _chosen_from(self, name: str, version: str | None, cached: Selection) -> list[ServiceInfo]:
+        """The entries of a cached lookup within the version range (memoised per lookup:
+        per list of entries the location service sent)."""
+        key = (name, version)
+        chosen = self._chosen.get(key)
+        if chosen is None or chosen[0] is not cached[1]:
+            chosen = (cached[1], select(cached[1], name, version))
+            with self._lock:
+                self._chosen[key] = chosen
+        return chosen[1]
 
     def forget(self, name: str) -> None:
-        """Drop the cached lookup (after a failure)."""
+        """Look ``name`` up again at its next use (after a failure); its entries stay known
+        as a fallback while the location service is away."""
         with self._lock:
-            self._cache.pop(name, None)
+            self._stale(name)
+
+    def _stale(self, name: str) -> None:
+        """Mark the cached lookup of ``name`` as too old (lock held)."""
+        cached = self._cache.get(name)
+        if cached is not None:
+            self._cache[name] = (float("-inf"), cached[1])
 
     def pick(self, found: list[ServiceInfo]) -> ServiceInfo:
-        """Round robin among the instances of the best version."""
+        """Round robin among the instances of the best version (not suspected, if any is)."""
         if len(found) == 1:
             return found[0]
+        if self._suspects:
+            trusted = [i for i in found if not self.suspected(i.instance)]
+            found = trusted or found
         top = [i for i in found if i.version == found[0].version]
         return top[next(self._turn) % len(top)]
 

@@ -9,26 +9,36 @@ from __future__ import annotations
 import collections
 import functools
 import logging
-import math
 import threading
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
+from robosoa.entries import (
+    BUS_ENTRY,
+    INTERNAL,
+    MAX_ENTRY,
+    MAX_OPERATIONS,
+    MAX_TEXT,
+    PATTERNS,
+    PUBLISHERS,
+    ServiceInfo,
+    select,
+)
 from robosoa.errors import RobosoaError
 from robosoa.federation import ask_all
 from robosoa.stats import Counter
-from robosoa.versions import version_key, version_matcher
 
 log = logging.getLogger("robosoa.location")
 
+__all__ = ["BUS_ENTRY", "INTERNAL", "MAX_ENTRY", "MAX_OPERATIONS", "MAX_TEXT", "PATTERNS",
+           "PUBLISHERS", "Limits", "LocationService", "Registry", "RegistryFull",
+           "ServiceInfo", "select"]
+
 Clock = Callable[[], float]
 PEER_BACKOFF = 5.0  # seconds a federated location service that failed is not asked again
-PATTERNS = ("request-response", "oneway", "publish-subscribe", "event", "point-to-point")
-MAX_TEXT = 1024  # characters of one text field of a registration (name, endpoint, ...)
-MAX_OPERATIONS = 1024  # operations one registration may list
-MAX_ENTRY = 16 * 1024  # characters of all text of one registration together
+
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,81 +50,6 @@ class Limits:
     max_per_peer: int = 1_000  # registrations from one peer (host address); more are refused
     max_peers: int = 32  # federated location services
     federation_timeout: float = 0.5  # seconds one lookup waits for all federated peers
-
-
-def _text(value: Any, key: str) -> str:
-    text = str(value)
-    if len(text) > MAX_TEXT:
-        raise ValueError(f"{key} is longer than {MAX_TEXT} characters")
-    return text
-
-
-def _ttl(value: Any) -> float:
-    ttl = float(value)
-    if not math.isfinite(ttl) or ttl < 0:
-        raise ValueError(f"ttl {value!r} is not a finite number >= 0")
-    return ttl
-
-
-@dataclass(frozen=True, slots=True)
-class ServiceInfo:
-    """What a provider instance registers: name, version, operations, pattern, endpoint."""
-
-    name: str
-    version: str
-    operations: tuple[str, ...]
-    pattern: str
-    endpoint: str
-    instance: str
-    group: str | None = None
-    host: str = ""
-    pid: int = 0
-    ttl: float = 0.0
-    origin: str = ""  # "" when local, else the federated location service it came from
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-compatible form."""
-        data = asdict(self)
-        data["operations"] = list(self.operations)
-        return data
-
-    @staticmethod
-    def from_dict(data: Mapping[str, Any]) -> ServiceInfo:
-        """Parse and check the dict form; raises ValueError naming the bad key."""
-        if not isinstance(data, Mapping):
-            raise ValueError("bad service entry: not an object")
-        try:
-            operations = data.get("operations", ())
-            if not isinstance(operations, list | tuple) or len(operations) > MAX_OPERATIONS:
-                raise ValueError(f"operations is not a list of at most {MAX_OPERATIONS}")
-            info = ServiceInfo(
-                name=_text(data["name"], "name"), version=_text(data["version"], "version"),
-                operations=tuple(_text(op, "operation") for op in operations),
-                pattern=str(data.get("pattern", "request-response")),
-                endpoint=_text(data["endpoint"], "endpoint"),
-                instance=_text(data["instance"], "instance"),
-                group=None if data.get("group") is None else _text(data["group"], "group"),
-                host=_text(data.get("host", ""), "host"), pid=int(data.get("pid", 0)),
-                ttl=_ttl(data.get("ttl", 0.0)), origin=_text(data.get("origin", ""), "origin"),
-            )
-        except (KeyError, TypeError, ValueError, OverflowError) as exc:
-            raise ValueError(f"bad service entry: {exc!r}") from None
-        if not info.name or not info.instance:
-            raise ValueError("bad service entry: empty name or instance")
-        if info.pattern not in PATTERNS:
-            raise ValueError(f"bad service entry: unknown pattern {info.pattern[:40]!r}")
-        texts = (info.name, info.version, info.endpoint, info.instance, info.group or "",
-                 info.host, info.origin, *info.operations)
-        if sum(map(len, texts)) > MAX_ENTRY:
-            raise ValueError(f"bad service entry: more than {MAX_ENTRY} characters of text")
-        return info
-
-
-def select(infos: list[ServiceInfo], name: str | None, version: str | None) -> list[ServiceInfo]:
-    """Entries for ``name`` within the version range, highest version first."""
-    accept = version_matcher(version)
-    chosen = [i for i in infos if (name is None or i.name == name) and accept(i.version)]
-    return sorted(chosen, key=lambda i: (i.name, tuple(-p for p in version_key(i.version))))
 
 
 class RegistryFull(ValueError):
@@ -132,6 +67,7 @@ class Registry:
                  limits: Limits = Limits()) -> None:
         self._entries: dict[str, tuple[ServiceInfo, float, str]] = {}  # (info, expiry, peer)
         self._per_peer: collections.Counter[str] = collections.Counter()
+        self._publishers = 0  # changes of the PUBLISHERS entries (a generation counter)
         self._default_ttl = default_ttl
         self._limits = limits
         self._clock = clock
@@ -149,6 +85,8 @@ class Registry:
             elif old[2] != peer:
                 raise RegistryFull(f"instance {info.instance[:80]!r} belongs to another peer")
             self._entries[info.instance] = (info, self._clock() + ttl, peer)
+            if info.name == PUBLISHERS and (old is None or old[0].endpoint != info.endpoint):
+                self._publishers += 1
         if old is None:
             log.info("registered", extra={"service": info.name, "instance": info.instance,
                                           "endpoint": info.endpoint, "peer": peer})
@@ -164,8 +102,13 @@ class Registry:
                                f"{limits.max_per_peer} entries (max_per_peer)")
         self._per_peer[peer] += 1
 
+    def publishers(self) -> int:
+        """How many times ``PUBLISHERS`` entries came, went or moved (a change counter)."""
+        return self._publishers
+
     def _drop(self, instance: str) -> ServiceInfo:
         info, _, peer = self._entries.pop(instance)
+        self._publishers += info.name == PUBLISHERS
         self._per_peer[peer] -= 1
         if self._per_peer[peer] <= 0:
             del self._per_peer[peer]

@@ -6,10 +6,11 @@ import itertools
 import json
 import os
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from enum import StrEnum
 from typing import Any, NamedTuple
 
+from robosoa import blobs
 from robosoa.errors import InvalidMessage
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_json
 
@@ -110,17 +111,63 @@ def to_dict(msg: Message) -> Payload:
     return out
 
 
-_ENCODE = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+def _refuse(value: object) -> object:
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
+def _encoder() -> Callable[[object], str]:
+    """json's C encoder built once, compact, ASCII, NaN and Infinity refused, as
+    ``JSONEncoder(separators=(",", ":"), allow_nan=False).encode`` writes; without its
+    per-call set-up and its circular-reference check (a payload that contains itself ends in
+    RecursionError instead, refused all the same)."""
+    make = getattr(json.encoder, "c_make_encoder", None)
+    if make is None:  # not CPython's _json: the pure-Python encoder
+        return json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode
+    iterencode = make(None, _refuse, json.encoder.encode_basestring_ascii, None, ":", ",",
+                      False, False, False)
+    return lambda value: "".join(iterencode(value, 0))
+
+
+_ENCODE = _encoder()
+_BAD = (TypeError, ValueError, RecursionError)
 _FIELD_SET = frozenset(_FIELDS)
 _KINDS = {kind.value: kind for kind in Kind}
 _TEXT_FIELDS = ("service", "operation", "topic", "reply_to", "correlation_id", "id")
 
 
 def encode(msg: Message) -> bytes:
-    """Serialize to UTF-8 JSON; raises InvalidMessage if the payload is not JSON-compatible."""
+    """Serialize to one frame of UTF-8 JSON; raises InvalidMessage if the payload is not
+    JSON-compatible (binary values need :func:`encode_frames`)."""
     try:
         return _ENCODE(to_dict(msg)).encode()
-    except (TypeError, ValueError) as exc:
+    except _BAD as exc:
+        raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
+
+
+Frames = list[bytes]
+
+
+def encode_frames(msg: Message) -> Frames:
+    """The wire frames of ``msg``: the JSON envelope, then one frame per binary value
+    (``robosoa.blobs``); raises InvalidMessage if the payload cannot be sent."""
+    return _frames(to_dict(msg), msg.payload)
+
+
+def _frames(data: Payload, payload: Payload) -> Frames:
+    """JSON of ``data`` (whose payload is ``payload``); binary values cut out on the slow path."""
+    try:
+        return [_ENCODE(data).encode()]
+    except (ValueError, RecursionError) as exc:
+        raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
+    except TypeError as exc:  # maybe bytes, which json cannot write: cut them out
+        problem = exc
+    plain, paths, values = blobs.split(payload)
+    if not paths:
+        raise InvalidMessage(f"payload is not JSON-compatible: {problem}") from None
+    data["payload"], data["blobs"] = plain, paths
+    try:
+        return [_ENCODE(data).encode(), *values]
+    except _BAD as exc:
         raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
 
 
@@ -142,17 +189,15 @@ def _why(data: dict[str, Any]) -> str:
 
 
 def encode_broadcast(kind: Kind, topic: str, payload: Payload,
-                     context: Payload | None = None) -> bytes:
-    """Wire form of a publish or event message, without building a Message first (hot path)."""
+                     context: Payload | None = None) -> Frames:
+    """Wire frames of a publish or event message, without building a Message first (hot
+    path)."""
     out: Payload = {"kind": kind, "id": new_id(), "timestamp": time.time(), "topic": topic}
     if payload:
         out["payload"] = payload
     if context:
         out["context"] = context
-    try:
-        return _ENCODE(out).encode()
-    except (TypeError, ValueError) as exc:
-        raise InvalidMessage(f"payload is not JSON-compatible: {exc}") from None
+    return _frames(out, payload)
 
 
 def from_dict(data: Any) -> Message:
@@ -183,15 +228,37 @@ def from_dict(data: Any) -> Message:
 
 
 def decode(raw: bytes, max_bytes: int = MAX_MESSAGE, max_depth: int = MAX_DEPTH) -> Message:
-    """Parse wire bytes from a peer within the size and depth limits (``robosoa.wire``);
+    """Parse one wire frame from a peer within the size and depth limits (``robosoa.wire``);
     raises InvalidMessage naming what is wrong."""
     return from_dict(load_json(raw, max_bytes, max_depth))
+
+
+def decode_frames(frames: Sequence[bytes], max_bytes: int = MAX_MESSAGE,
+                  max_depth: int = MAX_DEPTH) -> Message:
+    """Parse a message of one JSON frame and its binary frames (``robosoa.blobs``)."""
+    if len(frames) == 1:
+        return decode(frames[0], max_bytes, max_depth)
+    if not frames or len(frames) > blobs.MAX_BLOBS + 1:
+        raise InvalidMessage(f"message of {len(frames)} frames (at most "
+                             f"{blobs.MAX_BLOBS + 1})")
+    data = load_json(frames[0], max_bytes, max_depth)
+    if type(data) is not dict:
+        raise InvalidMessage("message is not a JSON object")
+    paths = data.pop("blobs", None)
+    msg = from_dict(data)
+    blobs.join(msg.payload, paths, frames[1:])
+    return msg
 
 
 def check_payload(payload: Mapping[str, Any] | None) -> Payload:
     """Coerce a caller's payload to a plain dict, refusing non-mappings and non-str keys."""
     if payload is None:
         return {}
+    if type(payload) is dict:  # the common case, without the ABC check
+        for key in payload:
+            if type(key) is not str:
+                raise InvalidMessage("payload keys must be strings")
+        return payload.copy()
     if not isinstance(payload, Mapping):
         raise InvalidMessage(f"payload must be a mapping, not {type(payload).__name__}")
     for key in payload:

@@ -18,6 +18,7 @@ from robosoa.transports.base import Inbox, Incoming
 log = logging.getLogger("robosoa.provider")
 
 ERROR_EVENT = "robosoa.error"  # event emitted when a one-way message cannot be handled
+_NUMBER = (float, int)
 
 
 class ProviderHandle:
@@ -25,8 +26,9 @@ class ProviderHandle:
 
     def __init__(self, info: ServiceInfo, dispatcher: Dispatcher, inbox: Inbox,
                  counter: Counter, on_error: Callable[[dict[str, str]], None],
-                 on_close: Callable[[ProviderHandle], None]) -> None:
+                 on_close: Callable[[ProviderHandle], None], slack: float = 0.0) -> None:
         self.info = info
+        self._slack = slack
         self._dispatcher = dispatcher
         self._inbox = inbox
         self._counter = counter
@@ -70,6 +72,10 @@ class ProviderHandle:
         if msg is None:
             self._counter.record(None, error=True)
             self._refuse(incoming, incoming.problem)
+            return
+        deadline: float = msg.context.get("deadline", 0.0)
+        if type(deadline) in _NUMBER and deadline and deadline + self._slack < time.time():
+            self._counter.drop("deadline")  # the consumer has given up: no reply, no work
             return
         start = time.perf_counter()
         outcome = self._dispatcher.dispatch(msg)

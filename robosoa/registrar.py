@@ -55,8 +55,9 @@ class Registrar:
         with self._lock:
             return list(self._handles.values())
 
-    def register(self, info: ServiceInfo) -> None:
-        """Register (or refresh) one entry; failures are logged, the next beat retries."""
+    def register(self, info: ServiceInfo) -> bool:
+        """Register (or refresh) one entry; False if the location service could not be
+        reached (logged; the next beat retries)."""
         try:
             reply = self._adapter.location({"op": "register", "service": info.to_dict()},
                                            self._options.location_timeout)
@@ -65,20 +66,31 @@ class Registrar:
                                                            "reason": reply["error"]})
         except RobosoaError as exc:
             log.warning("registration failed", extra={"service": info.name, "error": str(exc)})
+            return False
+        return True
 
     def register_all(self) -> None:
-        """Refresh every entry now (after a reconnect)."""
-        for handle in self.handles():
-            self.register(handle.info)
+        """Refresh every entry now (after a reconnect), the transport's own ones too; stops
+        at the first that cannot reach the location service (the others would wait too)."""
+        for info in [*(h.info for h in self.handles()), *self._adapter.registrations()]:
+            if not self.register(info):
+                return
 
     def _beat(self) -> None:
+        away = False
         while not self._stop.wait(self._options.heartbeat):
             if not self._adapter.connected:
                 continue  # disconnected: no heartbeats, so our entries expire
             try:
                 self._adapter.maintain()
-            except Exception as exc:
-                log.warning("transport maintenance failed", extra={"error": str(exc)})
+            except Exception as exc:  # the location service is away: try at the next beat
+                if not away:
+                    log.warning("location service unreachable", extra={"error": str(exc)})
+                away = True
+                continue
+            if away:
+                log.info("location service back: registering again")
+            away = False
             self.register_all()
 
     def stop(self) -> None:

@@ -1,4 +1,8 @@
-"""Counters and latency figures per service (count, errors, p50/p99) and per subscription."""
+"""Counters and latency figures per service (count, errors, p50/p99) and per subscription.
+
+Every message dropped is counted with the reason it was dropped (see ``REASONS`` and
+docs/runtime.md, *Fault behaviour*), so ``robosoa stats`` can say why.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +13,16 @@ from dataclasses import dataclass
 from typing import Any
 
 WINDOW = 2048  # latency samples kept per service: a bounded window, not a full history
+REASONS = {
+    "queue": "a bounded queue was full (asynchronous requests, inproc inboxes)",
+    "unreachable": "no instance could take the message (gone, or its bounded inbox full)",
+    "deadline": "a request reached its provider after the consumer's deadline",
+    "depth": "a subscription held its history depth: the oldest message made room",
+    "bytes": "a subscription held its byte budget: the oldest messages made room",
+    "lifespan": "a message was older than its lifespan",
+    "lost": "sequence numbers skipped: dropped in a ZeroMQ queue or a lost connection",
+    "blocked": "a reliable publish found no room within its blocking time",
+}
 
 
 def percentile(samples: list[float], fraction: float) -> float:
@@ -25,18 +39,19 @@ class ServiceFigures:
     """A snapshot of one service's counters; latencies in milliseconds."""
 
     key: str
-    role: str  # "provider", "consumer" or "subscriber"
+    role: str  # "provider", "consumer", "sender", "publisher", "subscriber", "wire", ...
     count: int
     errors: int
-    dropped: int
+    dropped: int  # the sum of ``drops``
     p50_ms: float
     p99_ms: float
+    drops: tuple[tuple[str, int], ...] = ()  # (reason, count), reasons of ``REASONS``
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-compatible form."""
         return {"key": self.key, "role": self.role, "count": self.count, "errors": self.errors,
-                "dropped": self.dropped, "p50_ms": round(self.p50_ms, 3),
-                "p99_ms": round(self.p99_ms, 3)}
+                "dropped": self.dropped, "drops": dict(self.drops),
+                "p50_ms": round(self.p50_ms, 3), "p99_ms": round(self.p99_ms, 3)}
 
 
 class Counter:
@@ -48,6 +63,7 @@ class Counter:
         self.count = 0
         self.errors = 0
         self.dropped = 0
+        self._drops: dict[str, int] = {}
         self._latency: deque[float] = deque(maxlen=WINDOW)
         self._lock = threading.Lock()
 
@@ -64,18 +80,21 @@ class Counter:
         with self._lock:
             self.errors += 1
 
-    def drop(self, n: int = 1) -> None:
-        """Count messages dropped or refused because a bounded queue was full."""
+    def drop(self, reason: str = "queue", n: int = 1) -> None:
+        """Count ``n`` messages dropped or refused, for ``reason`` (one of ``REASONS``)."""
         with self._lock:
             self.dropped += n
+            self._drops[reason] = self._drops.get(reason, 0) + n
 
     def figures(self) -> ServiceFigures:
         """A consistent snapshot."""
         with self._lock:
             samples = list(self._latency)
             count, errors, dropped = self.count, self.errors, self.dropped
+            drops = tuple(sorted(self._drops.items()))
         return ServiceFigures(self.key, self.role, count, errors, dropped,
-                              percentile(samples, 0.50) * 1000, percentile(samples, 0.99) * 1000)
+                              percentile(samples, 0.50) * 1000, percentile(samples, 0.99) * 1000,
+                              drops)
 
 
 class StatsBook:

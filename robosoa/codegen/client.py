@@ -57,17 +57,23 @@ def _one_way(op: Operation, checked: bool) -> list[str]:
 def _listen(d: ServiceDescriptor, op: Operation, checked: bool) -> list[str]:
     event = d.pattern is Pattern.EVENT
     kind = message_class(op) if op.parameters else ""
-    args = ["self", f"callback: Callable[[{kind}], None]"]
+    args = ["self", f"callback: Callable[[{kind}], None]", "qos: robosoa.QoS | None = None"]
     lines = def_line("    ", f"on_{op.name}", args, "robosoa.Subscription")
     what = "event" if event else "topic"
-    lines += docstring("        ", f"Call ``callback`` with each '{op.name}' {what} message.")
+    lines += docstring("        ", f"Call ``callback`` with each '{op.name}' {what} message; "
+                       "``qos`` overrides the descriptor's.")
     lines.append("        def deliver(message: robosoa.Message) -> None:")
     if checked:
         lines.append(f"            self._check_request({q(op.name)}, message.payload)")
     value = f"{kind}.from_payload(message.payload)" if kind else ""
     lines += [f"            callback({value})", ""]
     listen = "on" if event else "subscribe"
-    return [*lines, f"        return self._bus.{listen}(SERVICE + {q('.' + op.name)}, deliver)"]
+    return [
+        *lines,
+        f"        chosen = qos if qos is not None else DESCRIPTOR.qos({q(op.name)})",
+        *call("        ", f"return self._bus.{listen}",
+              [f"SERVICE + {q('.' + op.name)}", "deliver", "qos=chosen"]),
+    ]
 
 
 def _init(d: ServiceDescriptor, part: Participant, checked: bool) -> list[str]:

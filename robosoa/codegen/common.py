@@ -157,6 +157,15 @@ def _message(op: Operation) -> list[str]:
     return _dataclass(message_class(op), text, op.parameters)
 
 
+def _names_constant(constant: str, names: list[str]) -> list[str]:
+    """``NAME: tuple[str, ...] = (...)``, wrapped one name per line past 99 columns."""
+    inner = ", ".join(q(n) for n in names) + ("," if len(names) == 1 else "")
+    line = f"{constant}: tuple[str, ...] = ({inner})"
+    if len(line) <= 99:
+        return [line]
+    return [f"{constant}: tuple[str, ...] = (", *(f"    {q(n)}," for n in names), ")"]
+
+
 def render_types(d: ServiceDescriptor) -> str:
     """``types.py``: service constants, the embedded descriptor and the typed dataclasses."""
     names = ", ".join(q(op.name) for op in d.operations)
@@ -165,6 +174,7 @@ def render_types(d: ServiceDescriptor) -> str:
         f"VERSION = {q(d.version)}",
         f"PATTERN = {q(d.pattern.value)}",
         f"OPERATIONS: tuple[str, ...] = ({names}{',' if len(d.operations) == 1 else ''})",
+        *_names_constant("IDEMPOTENT", [op.name for op in d.operations if op.idempotent]),
         "",
         "# The descriptor this package was generated from; payloads are checked against it.",
         *_string_constant("DESCRIPTOR_XML", d.text),

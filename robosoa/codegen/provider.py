@@ -79,6 +79,7 @@ def _skeleton(d: ServiceDescriptor, part: Participant, protocol: str) -> list[st
         f"            pattern={q(_BUS_PATTERN.get(d.pattern, d.pattern.value))},",
         "            group=group,",
         f"            validator={validator},",
+        *(["            idempotent=IDEMPOTENT,"] if d.pattern.has_replies else []),
         "        )",
     ]
     for op in d.operations:
@@ -132,6 +133,10 @@ def _publisher(d: ServiceDescriptor, part: Participant) -> list[str]:
     lines += ["    def __init__(self, bus: robosoa.Bus) -> None:", "        self._bus = bus"]
     if part.profile is Profile.CHECKED:
         lines.append("        self._check = DESCRIPTOR.validator()")
+    event = ["event=True"] if d.pattern is Pattern.EVENT else []
+    for op in d.operations:  # binds the PUB now and declares each stream's QoS
+        args = [f"SERVICE + {q('.' + op.name)}", f"DESCRIPTOR.qos({q(op.name)})", *event]
+        lines += call("        ", "bus.advertise", args)
     for op in d.operations:
         items = ", ".join(f"{q(p.name)}: {p.name}" for p in op.parameters)
         lines += [
@@ -166,7 +171,8 @@ def render_provider(d: ServiceDescriptor, part: Participant) -> str:
         "typing": ["Any", "Protocol"],
         "robosoa": [],
         "robosoa.codegen.support": ["ExecutableRunner", "payload_of", "serve_main", "to_wire"],
-        ".types": ["DESCRIPTOR", "OPERATIONS", "SERVICE", "VERSION", *types_imported(d)],
+        ".types": ["DESCRIPTOR", "OPERATIONS", "SERVICE", "VERSION",
+                   *(["IDEMPOTENT"] if d.pattern.has_replies else []), *types_imported(d)],
     }
     if part.os.value != "any":
         groups["robosoa.codegen.support"].append("check_platform")

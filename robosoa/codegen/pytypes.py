@@ -5,7 +5,7 @@ from __future__ import annotations
 from robosoa.descriptor import Operation, Parameter, TypeRef, names
 from robosoa.descriptor.checks import default_value
 
-_PRIMITIVE = {"int": "int", "float": "float", "bool": "bool", "string": "str"}
+_PRIMITIVE = {"int": "int", "float": "float", "bool": "bool", "string": "str", "bytes": "bytes"}
 
 
 def q(value: object) -> str:

@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import robosoa
-from robosoa.codegen import xmlcodec
+from robosoa.codegen import textual, xmlcodec
 from robosoa.descriptor import Encoding, ServiceDescriptor
 from robosoa.errors import InvalidMessage
 from robosoa.wire import LimitExceeded, load_json, load_object
@@ -94,7 +94,7 @@ class ExecutableRunner:
             return str(next(iter(payload.values()), "")).encode()
         if self._encoding is Encoding.XML:
             return xmlcodec.encode_request(self._descriptor.name, operation, payload)
-        return json.dumps(dict(payload)).encode()
+        return json.dumps(dict(payload), default=textual.to_text).encode()
 
     def _decode(self, operation: str, output: bytes) -> dict[str, Any]:
         op = self._descriptor.operation(operation)
@@ -106,8 +106,9 @@ class ExecutableRunner:
         if self._encoding is Encoding.XML:
             return xmlcodec.decode_result(self._descriptor, returns, output)
         try:
-            return load_object(output or b"{}")
-        except InvalidMessage as exc:
+            return textual.fields_from_text(self._descriptor, returns,
+                                            load_object(output or b"{}"))
+        except (InvalidMessage, ValueError) as exc:
             why = f"{operation}: the program must print a JSON object ({exc})"
             raise RuntimeError(why) from None
 
@@ -145,6 +146,8 @@ def _argument(descriptor: ServiceDescriptor, operation: str, item: str) -> tuple
     declared = next((p for p in op.parameters if p.name == name), None) if op else None
     if declared is not None and declared.type.name == "string":
         return name, text
+    if declared is not None and declared.type.name == "bytes":
+        return name, textual.from_base64(text, name)
     try:
         return name, load_json(text)
     except LimitExceeded as exc:
@@ -175,5 +178,5 @@ def client_main(
         return 1
     finally:
         bus.close()
-    print(json.dumps(to_wire(result), default=str))
+    print(json.dumps(to_wire(result), default=textual.to_text))
     return 0

@@ -2,7 +2,8 @@
 
 A request is ``<request service="wdb" operation="query"><x>1</x></request>``; a result is
 ``<result><rows><item><key>a</key></item></rows></result>``. Lists hold ``<item>`` children,
-structs hold one child per field, booleans are ``true``/``false``. Decoding is driven by the
+structs hold one child per field, booleans are ``true``/``false``, bytes are base64 text
+(``robosoa.codegen.textual``). Decoding is driven by the
 descriptor's types, so the provider program writes plain text.
 """
 
@@ -13,6 +14,7 @@ from typing import Any
 
 from lxml import etree
 
+from robosoa.codegen.textual import from_base64, to_text
 from robosoa.descriptor import Parameter, ServiceDescriptor, TypeRef
 
 
@@ -26,6 +28,8 @@ def _fill(element: etree._Element, value: object) -> None:
             _fill(etree.SubElement(element, "item"), item)
     elif isinstance(value, bool):
         element.text = "true" if value else "false"
+    elif isinstance(value, bytes | bytearray | memoryview):
+        element.text = to_text(value)
     else:
         element.text = str(value)
 
@@ -54,6 +58,8 @@ def _value(d: ServiceDescriptor, t: TypeRef, element: etree._Element, path: str)
         return text.strip() in ("true", "1")
     if t.name == "string":
         return text
+    if t.name == "bytes":
+        return from_base64(text.strip(), path)
     struct = d.type(t.name)
     fields = struct.fields if struct is not None else ()
     return _fields(d, fields, element, f"{path}.")

@@ -26,6 +26,7 @@ from .model import (
     Pattern,
     Profile,
     ServiceDescriptor,
+    StreamQos,
     TypeDef,
     TypeRef,
 )
@@ -52,6 +53,7 @@ __all__ = [
     "Problem",
     "Profile",
     "ServiceDescriptor",
+    "StreamQos",
     "TypeDef",
     "TypeRef",
     "check_value",

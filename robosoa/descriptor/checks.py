@@ -20,6 +20,7 @@ from .model import (
     Participant,
     Pattern,
     ServiceDescriptor,
+    StreamQos,
     TypeRef,
 )
 from .names import name_problems
@@ -131,7 +132,7 @@ def _defaults(d: ServiceDescriptor) -> Iterator[Problem]:
             continue
         if p.required:
             yield Problem(d.source, p.line, label, "a required value cannot have a default")
-        elif not p.type.is_primitive:
+        elif not p.type.is_primitive or p.type.name == "bytes":
             yield Problem(d.source, p.line, label, f"type '{p.type}' cannot have a default")
         elif default_value(p.type, p.default) is None:
             yield Problem(d.source, p.line, label, f"default '{p.default}' is not a valid {p.type}")
@@ -140,7 +141,14 @@ def _defaults(d: ServiceDescriptor) -> Iterator[Problem]:
 def _pattern(d: ServiceDescriptor) -> Iterator[Problem]:
     if d.delivery != "one" and d.pattern is not Pattern.ONE_WAY:
         yield Problem(d.source, d.line, "pattern", "delivery applies to one-way only")
+    streams = (Pattern.PUBLISH_SUBSCRIBE, Pattern.EVENT)
     for op in d.operations:
+        if op.qos is not None:
+            yield from _qos(d, op, op.qos, d.pattern in streams)
+        if op.idempotent and not d.pattern.has_replies:
+            yield Problem(d.source, op.line, f"operation '{op.name}' attribute 'idempotent'",
+                          "applies to request-response and point-to-point only (a retry "
+                          "after a lost reply)")
         if op.returns and not d.pattern.has_replies:
             yield Problem(
                 d.source,
@@ -148,6 +156,20 @@ def _pattern(d: ServiceDescriptor) -> Iterator[Problem]:
                 f"operation '{op.name}' return '{op.returns[0].name}'",
                 f"pattern '{d.pattern}' has no replies, so no return values",
             )
+
+
+def _qos(d: ServiceDescriptor, op: Operation, qos: StreamQos, stream: bool) -> Iterator[Problem]:
+    label = f"operation '{op.name}' qos"
+    if not stream:
+        yield Problem(d.source, qos.line, label,
+                      "applies to publish-subscribe and event only (a stream's quality)")
+        return
+    try:
+        qos.settings()
+    except ValueError as exc:
+        why = str(exc).removeprefix("bad QoS: ")
+        why = why.replace("keep_latest", "keep-latest").replace("max_bytes", "max-bytes")
+        yield Problem(d.source, qos.line, label, why)
 
 
 def _participant(d: ServiceDescriptor, part: Participant) -> Iterator[Problem]:
@@ -243,12 +265,12 @@ def _text_encoding(d: ServiceDescriptor, op: Operation, line: int, here: str) ->
 
 def _c_operation(d: ServiceDescriptor, op: Operation, here: str) -> Iterator[Problem]:
     for value in (*op.parameters, *op.returns):
-        if not value.type.is_primitive:
+        if not value.type.is_primitive or value.type.name == "bytes":
             yield Problem(
                 d.source,
                 value.line,
                 f"operation '{op.name}' '{value.name}'",
-                f"type '{value.type}' cannot cross a C call (primitives only)",
+                f"type '{value.type}' cannot cross a C call (int, float, bool, string only)",
             )
     if len(op.returns) > 1:
         yield Problem(

@@ -36,6 +36,7 @@ from .model import (
     Pattern,
     Profile,
     ServiceDescriptor,
+    StreamQos,
     TypeDef,
     TypeRef,
 )
@@ -51,6 +52,7 @@ _LABELS = {
     "field": "field",
     "command": "command",
     "function": "function",
+    "qos": "qos",
 }
 _DECLARATION = re.compile(r"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)
 MAX_DESCRIPTOR_BYTES = 1024 * 1024  # a descriptor is a page of XML; 1 MiB is plenty
@@ -211,6 +213,32 @@ def _operation(element: _Element) -> Operation:
         parameters=tuple(_typed(e) for e in element.findall("param")),
         returns=tuple(_typed(e) for e in element.findall("return")),
         definition=_text(element.find("definition")),
+        line=_line(element),
+        idempotent=element.get("idempotent") in ("true", "1"),
+        qos=_qos(element.find("qos")),
+    )
+
+
+def _whole(text: str | None) -> int | None:
+    """A schema-checked positive integer; one of more than 18 digits as 10**18 (past every
+    limit, so the checks report it, and int() never parses thousands of digits)."""
+    if text is None:
+        return None
+    return int(text) if len(text.strip()) <= 18 else 10**18
+
+
+def _qos(element: _Element | None) -> StreamQos | None:
+    if element is None:
+        return None
+    depth, max_bytes = element.get("depth"), element.get("max-bytes")
+    lifespan, block = element.get("lifespan"), element.get("block")
+    return StreamQos(
+        depth=_whole(depth),
+        max_bytes=_whole(max_bytes),
+        lifespan=float(lifespan) if lifespan is not None else None,
+        keep_latest=element.get("keep-latest") in ("true", "1"),
+        reliable=element.get("reliable") in ("true", "1"),
+        block=float(block) if block is not None else None,
         line=_line(element),
     )
 

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
+from robosoa.qos import QoS
+
 
 class Pattern(StrEnum):
     """Message exchange patterns of the thesis (p. 62)."""
@@ -89,7 +91,7 @@ class Profile(StrEnum):
     UNCHECKED = "unchecked"
 
 
-PRIMITIVES: tuple[str, ...] = ("int", "float", "bool", "string")
+PRIMITIVES: tuple[str, ...] = ("int", "float", "bool", "string", "bytes")
 
 
 @dataclass(frozen=True, slots=True)
@@ -136,6 +138,27 @@ class TypeDef:
 
 
 @dataclass(frozen=True, slots=True)
+class StreamQos:
+    """The ``<qos>`` of a topic or event: what was written (None: the default), and where."""
+
+    depth: int | None
+    max_bytes: int | None
+    lifespan: float | None
+    keep_latest: bool
+    reliable: bool
+    block: float | None
+    line: int
+
+    def settings(self) -> QoS:
+        """The runtime's QoS (robosoa.qos.QoS) with these settings; raises ValueError for
+        a combination the semantic checks refuse."""
+        given: dict[str, Any] = {"depth": self.depth, "max_bytes": self.max_bytes,
+                                 "lifespan": self.lifespan, "block": self.block}
+        return QoS(keep_latest=self.keep_latest, reliable=self.reliable,
+                   **{k: v for k, v in given.items() if v is not None})
+
+
+@dataclass(frozen=True, slots=True)
 class Operation:
     """An operation with its call parameters and return values."""
 
@@ -144,6 +167,8 @@ class Operation:
     returns: tuple[Parameter, ...]
     definition: str
     line: int
+    idempotent: bool = False  # a consumer may retry it on another instance (fail-over)
+    qos: StreamQos | None = None  # publish-subscribe and event: the stream's QoS
 
 
 @dataclass(frozen=True, slots=True)
@@ -239,6 +264,14 @@ class ServiceDescriptor:
     def participant(self, packaging: Packaging) -> Participant | None:
         """The participant packaged as ``packaging``, if the descriptor declares one."""
         return next((p for p in self.participants if p.packaging == packaging), None)
+
+    def qos(self, operation: str) -> QoS:
+        """The QoS of the topic or event ``operation`` (the default without ``<qos>``), for
+        ``bus.advertise`` and ``bus.subscribe``; generated code passes it."""
+        op = self.operation(operation)
+        if op is None:
+            raise KeyError(f"service '{self.name}' has no operation '{operation}'")
+        return op.qos.settings() if op.qos is not None else QoS()
 
     def validator(self) -> Callable[[str, Mapping[str, Any]], None]:
         """A request checker ``(operation, payload) -> None`` for ``bus.provide(validator=)``.

@@ -36,7 +36,8 @@ RESERVED = frozenset({
     "client_main", "serve_main", "ExecutableRunner", "check_platform", "ServiceDescriptor",
     "loads",
     # definitions
-    "SERVICE", "VERSION", "PATTERN", "OPERATIONS", "DESCRIPTOR_XML", "DESCRIPTOR", "COMMANDS",
+    "SERVICE", "VERSION", "PATTERN", "OPERATIONS", "IDEMPOTENT", "DESCRIPTOR_XML", "DESCRIPTOR",
+    "COMMANDS",
     "LIBRARY", "main", "bind",
     # method parameters and members of the generated dataclasses
     "self", "cls", "from_payload", "to_payload",

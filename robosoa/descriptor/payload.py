@@ -20,6 +20,7 @@ _PRIMITIVE_TYPES: dict[str, tuple[type, ...]] = {
     "float": (float, int),
     "bool": (bool,),
     "string": (str,),
+    "bytes": (bytes, bytearray, memoryview),
 }
 
 
@@ -37,7 +38,8 @@ def _invalid(reason: str) -> InvalidMessage:
 
 
 def _kind(value: object) -> str:
-    names: dict[type, str] = {dict: "struct", list: "list", tuple: "list", str: "string"}
+    names: dict[type, str] = {dict: "struct", list: "list", tuple: "list", str: "string",
+                              bytearray: "bytes", memoryview: "bytes"}
     return names.get(type(value), type(value).__name__)
 
 

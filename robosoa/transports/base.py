@@ -7,22 +7,45 @@ broker channels. Adding a transport means one new module implementing this class
 
 from __future__ import annotations
 
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from robosoa.errors import RobosoaError
-from robosoa.message import Message
+from robosoa.errors import PublishTimeout, RobosoaError
+from robosoa.location import ServiceInfo
+from robosoa.message import Frames, Message
 from robosoa.stats import StatsBook
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
-Sink = Callable[[Message], None]  # must never block: it enqueues into a bounded queue
+# (message, its size in bytes on the wire, the expiry its publisher gave it or 0, whether the
+# transport can hold it back) -> whether it was taken (False only when holding back is
+# possible and a reliable subscription is full: offer it again later). Never blocks.
+Sink = Callable[[Message, int, float, bool], bool]
 ReplyFn = Callable[[Message], None]
+
+
+def offer_until(sink: Sink, offer: tuple[Message, int, float], deadline: float,
+                channel: str) -> None:
+    """Offer a message until ``sink`` takes it (a reliable sink may refuse while full),
+    backing off up to 10 ms; PublishTimeout once ``deadline`` (monotonic) has passed."""
+    pause = 0.0005
+    start = time.monotonic()
+    while not sink(*offer, True):
+        if time.monotonic() >= deadline:
+            raise PublishTimeout(channel[2:], max(0.0, deadline - start))
+        time.sleep(pause)
+        pause = min(pause * 2, 0.01)
 
 
 class Unreachable(RobosoaError):
     """A provider endpoint cannot take a message right now (gone, or its queue is full)."""
+
+
+class Lost(RobosoaError):
+    """The connection to an endpoint went away after a message was handed over to it (the
+    peer died, or heartbeats stopped coming back): no reply can come any more."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,6 +63,12 @@ class BusOptions:
     advertise_host: str = ""  # zmq: host name/IP other machines use to reach our providers
     max_message: int = MAX_MESSAGE  # bytes per frame taken from a peer (ZeroMQ MAXMSGSIZE)
     max_depth: int = MAX_DEPTH  # JSON nesting taken from a peer (robosoa.wire)
+    link_heartbeat: float = 1.0  # zmq: seconds between ZMTP heartbeats on every connection
+    link_timeout: float = 3.0  # zmq: a connection silent this long is closed (peer dead/cut off)
+    deadline_slack: float = 0.0  # a provider still runs requests this late (clocks that differ)
+    curve_secret: str = ""  # zmq: this participant's certificate (NAME.key_secret); "" = off
+    curve_allow: str = ""  # zmq: folder of the public certificates allowed on the bus
+    curve_location: str = ""  # zmq: the location service's certificate (default allow/location.key)
 
 
 class Incoming(NamedTuple):
@@ -57,6 +86,7 @@ class Inbox(ABC):
     """A provider instance's bounded receive queue; its endpoint is what gets registered."""
 
     endpoint: str
+    key: str = ""  # the endpoint's public key when the transport authenticates (zmq CURVE)
 
     @abstractmethod
     def receive(self, timeout: float) -> Incoming | None:
@@ -119,6 +149,16 @@ class ProtocolAdapter(ABC):
         """Periodic housekeeping, called from the bus's heartbeat thread (default: nothing)."""
         return None
 
+    def advertise(self, channel: str) -> None:
+        """Get ready to publish on ``channel`` so subscribers can find this bus before its
+        first message (default: nothing to prepare)."""
+        return None
+
+    def registrations(self) -> list[ServiceInfo]:
+        """Entries the transport keeps registered for itself besides the providers (e.g. a
+        PUB socket subscribers connect to); the bus's heartbeats refresh them."""
+        return []
+
     # --- location service -----------------------------------------------------------
     @abstractmethod
     def location(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
@@ -143,8 +183,17 @@ class ProtocolAdapter(ABC):
 
     # --- broker (publish/subscribe and events) --------------------------------------
     @abstractmethod
-    def publish(self, channel: str, raw: bytes) -> None:
-        """Send an encoded message to every subscriber of ``channel`` (never blocks; may drop)."""
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
+        """Send an encoded message (``encode_broadcast``: the JSON frame and its binary
+        frames) to every subscriber of ``channel``, with the expiry (epoch seconds, 0: none)
+        its sinks get. ``block`` None: best effort, never blocks, may drop. A number: the
+        topic is reliable, wait up to that long for room, then raise PublishTimeout."""
+
+    def room(self, channel: str) -> None:
+        """A subscription of ``channel`` that refused a message (reliable, full) has room
+        again (default: nothing to do; the publisher retries by itself)."""
+        return None
 
     @abstractmethod
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:

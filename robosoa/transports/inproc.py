@@ -15,7 +15,7 @@ from typing import Any
 
 from robosoa.errors import BusClosed, RequestTimeout
 from robosoa.location import LocationService, Peer, Registry, ServiceInfo
-from robosoa.message import Message, decode, encode
+from robosoa.message import Frames, Message, decode_frames, encode_frames
 from robosoa.transports.base import (
     BusOptions,
     Inbox,
@@ -23,6 +23,7 @@ from robosoa.transports.base import (
     ProtocolAdapter,
     Sink,
     Unreachable,
+    offer_until,
 )
 
 DEFAULT_NAME = "default"
@@ -101,7 +102,9 @@ class _ReplySlot:
         self.options = options
 
     def set(self, message: Message) -> None:
-        self.message = decode(encode(message), self.options.max_message, self.options.max_depth)
+        options = self.options
+        self.message = decode_frames(encode_frames(message), options.max_message,
+                                     options.max_depth)
         self.event.set()
 
 
@@ -176,7 +179,8 @@ class InprocAdapter(ProtocolAdapter):
 
     def _copy(self, msg: Message) -> Message:
         """The message as the receiver gets it: encoded and decoded within the same limits."""
-        return decode(encode(msg), self.options.max_message, self.options.max_depth)
+        return decode_frames(encode_frames(msg), self.options.max_message,
+                             self.options.max_depth)
 
     def open_inbox(self, instance: str) -> Inbox:
         broker = self._live()
@@ -186,14 +190,21 @@ class InprocAdapter(ProtocolAdapter):
             broker.inboxes[endpoint] = inbox
         return inbox
 
-    def publish(self, channel: str, raw: bytes) -> None:
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
         broker = self._live()
         with broker.lock:
             sinks = list(broker.channels.get(channel, ()))
         if sinks:
-            delivered = decode(raw, self.options.max_message, self.options.max_depth)
+            delivered = decode_frames(frames, self.options.max_message, self.options.max_depth)
+            size = sum(map(len, frames))
+            if block is None:
+                for sink in sinks:
+                    sink(delivered, size, expires, False)
+                return
+            deadline = time.monotonic() + block
             for sink in sinks:
-                sink(delivered)
+                offer_until(sink, (delivered, size, expires), deadline, channel)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         broker = self._live()

@@ -1,41 +1,44 @@
 """The ZeroMQ transport: providers and consumers in separate processes or machines.
 
 Topology (see docs/runtime.md): a location-service process binds a ROUTER for the location
-protocol and runs an XSUB/XPUB forwarder (the message broker) for topics and events. Each
-provider instance binds its own ROUTER and registers that endpoint; consumers connect a
-DEALER per (thread, endpoint) and talk to providers directly.
+protocol and a PUB for announcements. Each provider instance binds its own ROUTER and
+registers that endpoint; consumers connect a DEALER per (thread, endpoint) and talk to
+providers directly. Each bus that publishes binds its own PUB and registers it; subscribers
+connect to every registered PUB directly (``zmq_topics``): there is no broker.
 """
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import threading
 import time
-from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any
 
 import zmq
+from zmq.auth.thread import ThreadAuthenticator
 
 from robosoa.errors import BusClosed, InvalidMessage, RequestTimeout, RobosoaError
-from robosoa.message import Message, decode, encode
+from robosoa.location import ServiceInfo
+from robosoa.message import Frames, Message, decode_frames, encode_frames
+from robosoa.transports import zmq_curve as curve
 from robosoa.transports.base import (
     BusOptions,
     Inbox,
+    Lost,
     ProtocolAdapter,
     Sink,
     Unreachable,
 )
+from robosoa.transports.zmq_dealers import Dealers
 from robosoa.transports.zmq_inbox import ZmqInbox
-from robosoa.transports.zmq_pubsub import Feed
-from robosoa.transports.zmq_sockets import check_endpoint, limit_input, public
+from robosoa.transports.zmq_sockets import check_endpoint, public
+from robosoa.transports.zmq_topics import Topics
 from robosoa.wire import load_object
 
-SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
-SLICE_MS = int(SLICE * 1000) + 1
-_NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
-SOCKETS_PER_THREAD = 64  # consumer DEALERs kept per thread (least recently used closed)
+CONNECT_WAIT = 0.5  # seconds a new connection to a provider gets to come up
 
 
 class ZmqAdapter(ProtocolAdapter):
@@ -48,20 +51,48 @@ class ZmqAdapter(ProtocolAdapter):
         self.endpoint = address.removeprefix("zmq://")
         check_endpoint(self.endpoint)  # validates early, with a readable error
         self._ctx: zmq.Context[zmq.Socket[bytes]] | None = None
-        self._local = threading.local()
-        self._sockets: set[zmq.Socket[bytes]] = set()
-        self._lock = threading.Lock()
+        self._dealers: Dealers | None = None
         self._rids = itertools.count(1)
         self._closing = False
         self._in_flight = 0
         self._idle = threading.Condition()
-        self._feed: Feed | None = None
-        self._broker: tuple[str, str] = ("", "")
+        self._topics: Topics | None = None
+        self._curve = curve.load(options.curve_secret, options.curve_allow,
+                                 options.curve_location)
+        self._auth: ThreadAuthenticator | None = None
+        self._keys: dict[str, bytes] = {}  # endpoint -> its server's CURVE key (from lookups)
 
     # --- SOA_Base ---------------------------------------------------------------------
     def configure(self) -> None:
         if self._ctx is None:
             self._ctx = zmq.Context()
+            if self._curve is not None:  # the ZAP handler first: nothing binds without it
+                self._auth = self._curve.authenticator(self._ctx)
+            setup = self._secure if self._curve is not None else None
+            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing, setup)
+            self._topics = Topics(self._ctx, self.endpoint, self.options, self.location,
+                                  self.rejected, self._lost, self._curve)
+
+    def _secure(self, sock: zmq.Socket[bytes], endpoint: str) -> None:
+        """CURVE client set-up of a DEALER: the server key of ``endpoint``."""
+        assert self._curve is not None
+        key = self._curve.location if endpoint == self.endpoint else self._keys.get(endpoint)
+        if not key:
+            raise Unreachable(f"no CURVE key known for {endpoint}")
+        self._curve.client(sock, key)
+
+    def _learn(self, reply: dict[str, Any]) -> None:
+        """Remember the CURVE keys of the endpoints a lookup returned."""
+        found = reply.get("services")
+        if self._curve is None or not isinstance(found, list):
+            return
+        if len(self._keys) > 65536:
+            self._keys.clear()
+        for entry in found:
+            if isinstance(entry, dict):
+                endpoint, key = entry.get("endpoint"), entry.get("key")
+                if isinstance(endpoint, str) and isinstance(key, str) and len(key) == 40:
+                    self._keys[endpoint] = key.encode()
 
     def connect(self) -> None:
         if self._closing:
@@ -69,33 +100,33 @@ class ZmqAdapter(ProtocolAdapter):
         self.configure()
         self.connected = True
         hello = self.location({"op": "hello"}, self.options.location_timeout)
-        broker = (public(str(hello.get("xsub", "")), self.endpoint),
-                  public(str(hello.get("xpub", "")), self.endpoint))
-        if not all(broker):
-            raise RobosoaError(f"location service at {self.endpoint} has no message broker")
-        if self._feed is None:
-            assert self._ctx is not None
-            self._feed = Feed(self._ctx, broker, self.options, self.rejected)
-        elif broker != self._broker:
-            self._feed.move(broker)
-        self._broker = broker
+        announce = public(str(hello.get("announce", "")), self.endpoint)
+        if not announce:
+            raise RobosoaError(f"location service at {self.endpoint} makes no announcements "
+                               "(an older robosoa?)")
+        assert self._topics is not None
+        self._topics.follow(announce)
 
     def disconnect(self) -> None:
         self.connected = False
 
     def shutdown(self) -> None:
+        if self.connected and not self._closing:
+            for info in self.registrations():  # best effort; otherwise they expire
+                with contextlib.suppress(RobosoaError):
+                    self.location({"op": "unregister", "instance": info.instance}, 0.5)
         self.connected = False
         with self._idle:
             self._closing = True  # waits in flight end within one SLICE
             self._idle.wait_for(lambda: self._in_flight == 0, timeout=2.0)
-        if self._feed is not None:
-            self._feed.close()
-            self._feed = None
-        with self._lock:
-            sockets = list(self._sockets)
-            self._sockets.clear()
-        for sock in sockets:
-            sock.close(0)
+        if self._topics is not None:
+            self._topics.close()
+            self._topics = None
+        if self._dealers is not None:
+            self._dealers.close()
+        if self._auth is not None:
+            self._auth.stop()
+            self._auth = None
         if self._ctx is not None:
             self._ctx.destroy(linger=0)
             self._ctx = None
@@ -106,82 +137,18 @@ class ZmqAdapter(ProtocolAdapter):
         return time.perf_counter() - start
 
     def maintain(self) -> None:
-        """Follow a restarted location service whose broker endpoints changed."""
+        """Follow a restarted location service whose announcement endpoint changed."""
+        if self._topics is not None:
+            self._topics.tidy()
         self.connect()
 
-    # --- consumer sockets (one DEALER per thread and endpoint) -------------------------
-    def _dealer(self, endpoint: str) -> zmq.Socket[bytes]:
-        if self._closing or self._ctx is None:
-            raise BusClosed(f"bus {self.address} is closed")
-        cache: OrderedDict[str, zmq.Socket[bytes]] | None = getattr(self._local, "dealers", None)
-        if cache is None:
-            cache = self._local.dealers = OrderedDict()
-        sock = cache.get(endpoint)
-        if sock is not None:
-            cache.move_to_end(endpoint)
-            return sock
-        sock = self._ctx.socket(zmq.DEALER)
-        sock.setsockopt(zmq.LINGER, 0)
-        sock.setsockopt(zmq.IMMEDIATE, 1)  # never queue for a peer that is not connected
-        sock.setsockopt(zmq.SNDHWM, self.options.hwm)
-        sock.setsockopt(zmq.RCVHWM, self.options.hwm)
-        sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-        limit_input(sock, self.options.max_message)
-        sock.connect(endpoint)
-        cache[endpoint] = sock
-        with self._lock:
-            self._sockets.add(sock)
-        if len(cache) > SOCKETS_PER_THREAD:
-            self._drop(cache.popitem(last=False)[0], cache)
-        return sock
+    def registrations(self) -> list[ServiceInfo]:
+        """This bus's PUB, once it has published."""
+        return self._topics.registrations() if self._topics is not None else []
 
-    def _drop(self, endpoint: str, cache: OrderedDict[str, zmq.Socket[bytes]] | None = None
-              ) -> None:
-        cache = cache if cache is not None else getattr(self._local, "dealers", None)
-        sock = None if cache is None else cache.pop(endpoint, None)
-        if sock is not None:
-            with self._lock:
-                self._sockets.discard(sock)
-            sock.close(0)
-
-    def _send(self, endpoint: str, raw: bytes, wait: float) -> zmq.Socket[bytes]:
-        sock = self._dealer(endpoint)
-        deadline = time.monotonic() + wait
-        while True:
-            try:
-                sock.send(raw, _NOBLOCK)
-                return sock
-            except zmq.Again:
-                remaining = deadline - time.monotonic()
-                if remaining <= 0 or self._closing:
-                    self._drop(endpoint)
-                    raise Unreachable(f"no connection to {endpoint}") from None
-                sock.poll(int(min(remaining, SLICE) * 1000) + 1, zmq.POLLOUT)
-
-    def _receive(self, sock: zmq.Socket[bytes], deadline: float,
-                 accept: Callable[[bytes], Any]) -> Any:
-        """Wait for the reply ``accept`` recognises (stale replies are skipped).
-
-        Blocks in ``recv`` with a receive timeout (no poller: cheaper on the hot path), in
-        slices so that closing the bus ends the wait promptly.
-        """
-        while True:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0 or self._closing:
-                return None
-            wait = int(min(remaining, SLICE) * 1000) + 1
-            if wait != SLICE_MS:  # the socket is created with SLICE; shorter waits set it
-                sock.setsockopt(zmq.RCVTIMEO, wait)
-            try:
-                data = sock.recv()
-            except zmq.Again:
-                continue
-            finally:
-                if wait != SLICE_MS:
-                    sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-            found = accept(data)
-            if found is not None:
-                return found
+    def _lost(self, channel: str, n: int) -> None:
+        """Messages a publisher sent on ``channel`` that never arrived (sequence gap)."""
+        self.stats_book.counter(channel[2:], "subscriber").drop("lost", n)
 
     def location(self, request: dict[str, Any], timeout: float) -> dict[str, Any]:
         self._enter()
@@ -196,24 +163,33 @@ class ZmqAdapter(ProtocolAdapter):
         rid = next(self._rids)
         raw = json.dumps({**request, "rid": rid}).encode()
         deadline = time.monotonic() + timeout
+        dealers = self._live_dealers()
         try:
-            sock = self._send(self.endpoint, raw, timeout)
+            sock = dealers.send(self.endpoint, [raw], timeout, fail_fast=False)
         except Unreachable:
             raise RobosoaError(f"location service at {self.endpoint} is not reachable") from None
 
-        def accept(data: bytes) -> dict[str, Any] | None:
+        def accept(frames: list[bytes]) -> dict[str, Any] | None:
             try:
-                reply = load_object(data, self.options.max_message, self.options.max_depth)
+                if len(frames) != 1:
+                    raise InvalidMessage(f"expected one frame, got {len(frames)}")
+                reply = load_object(frames[0], self.options.max_message,
+                                    self.options.max_depth)
             except InvalidMessage:
                 self.rejected("location")
                 return None
             return reply if reply.get("rid") == rid else None
 
-        reply: dict[str, Any] | None = self._receive(sock, deadline, accept)
+        try:
+            reply: dict[str, Any] | None = dealers.receive(sock, self.endpoint, deadline, accept)
+        except Lost:
+            raise RobosoaError(f"location service at {self.endpoint}: connection lost") from None
         if reply is None:
-            self._drop(self.endpoint)
+            dealers.drop(self.endpoint)
             raise RobosoaError(f"location service at {self.endpoint} did not answer "
                                f"within {timeout:g}s")
+        if request.get("op") == "lookup":
+            self._learn(reply)
         return reply
 
     def call(self, endpoint: str, msg: Message, timeout: float) -> Message:
@@ -225,19 +201,20 @@ class ZmqAdapter(ProtocolAdapter):
 
     def _call(self, endpoint: str, msg: Message, timeout: float) -> Message:
         deadline = time.monotonic() + timeout
-        sock = self._send(endpoint, encode(msg), min(timeout, 0.5))
+        dealers = self._live_dealers()
+        sock = dealers.send(endpoint, encode_frames(msg), min(timeout, CONNECT_WAIT))
 
-        def accept(data: bytes) -> Message | None:
+        def accept(frames: list[bytes]) -> Message | None:
             try:
-                reply = decode(data, self.options.max_message, self.options.max_depth)
+                reply = decode_frames(frames, self.options.max_message, self.options.max_depth)
             except InvalidMessage:
                 self.rejected("reply")
                 return None
             return reply if reply.correlation_id in (msg.id, "") else None
 
-        reply: Message | None = self._receive(sock, deadline, accept)
+        reply: Message | None = dealers.receive(sock, endpoint, deadline, accept)
         if reply is None:
-            self._drop(endpoint)
+            dealers.drop(endpoint)
             if self._closing:
                 raise BusClosed(f"bus {self.address} closed during the request")
             raise RequestTimeout(msg.service, msg.operation, timeout)
@@ -246,9 +223,14 @@ class ZmqAdapter(ProtocolAdapter):
     def post(self, endpoint: str, msg: Message) -> None:
         self._enter()
         try:
-            self._send(endpoint, encode(msg), 0.5)
+            self._live_dealers().send(endpoint, encode_frames(msg), CONNECT_WAIT)
         finally:
             self._leave()
+
+    def _live_dealers(self) -> Dealers:
+        if self._dealers is None or self._closing:
+            raise BusClosed(f"bus {self.address} is closed")
+        return self._dealers
 
     def _enter(self) -> None:
         """Count a call in flight so ``shutdown`` never closes a socket another thread uses."""
@@ -267,15 +249,23 @@ class ZmqAdapter(ProtocolAdapter):
     def open_inbox(self, instance: str) -> Inbox:
         if self._ctx is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected)
+        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected, self._curve)
 
-    def _live_feed(self) -> Feed:
-        if self._feed is None or not self.connected:
+    def _live_topics(self) -> Topics:
+        if self._topics is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return self._feed
+        return self._topics
 
-    def publish(self, channel: str, raw: bytes) -> None:
-        self._live_feed().publish(channel, raw)
+    def advertise(self, channel: str) -> None:
+        self._live_topics().outlet()
+
+    def publish(self, channel: str, frames: Frames, expires: float = 0.0,
+                block: float | None = None) -> None:
+        self._live_topics().publish(channel, frames, expires, block)
+
+    def room(self, channel: str) -> None:
+        if self._topics is not None:
+            self._topics.room(channel)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
-        return self._live_feed().subscribe(channel, sink)
+        return self._live_topics().subscribe(channel, sink)

@@ -8,9 +8,16 @@ from collections.abc import Callable
 import zmq
 
 from robosoa.errors import InvalidMessage
-from robosoa.message import Kind, Message, decode, encode
+from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
-from robosoa.transports.zmq_sockets import bind_provider, limit_input
+from robosoa.transports.zmq_curve import Curve
+from robosoa.transports.zmq_sockets import (
+    bind_provider,
+    keepalive,
+    limit_input,
+    recv_rest,
+    send_frames,
+)
 
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
 _MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
@@ -18,14 +25,16 @@ _RCVMORE = int(zmq.RCVMORE)
 
 
 class ZmqInbox(Inbox):
-    """A provider ROUTER: one frame of JSON per message, replies routed by identity.
+    """A provider ROUTER: a JSON frame (and its binary frames) per message, replies routed
+    by identity.
 
     The serving thread blocks in ``recv`` (receive timeout); ``wake`` sends a secret token to
     our own endpoint, so no poller is needed on the hot path.
     """
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
-                 options: BusOptions, rejected: Callable[[str], None]) -> None:
+                 options: BusOptions, rejected: Callable[[str], None],
+                 curve: Curve | None = None) -> None:
         self._ctx = ctx
         self._options = options
         self._rejected = rejected
@@ -34,6 +43,11 @@ class ZmqInbox(Inbox):
         self._router.setsockopt(zmq.RCVHWM, options.inbox_size)
         self._router.setsockopt(zmq.SNDHWM, options.hwm)
         limit_input(self._router, options.max_message)
+        keepalive(self._router, options.link_heartbeat, options.link_timeout)
+        if curve is not None:
+            curve.serve(self._router)
+            self.key = curve.public.decode()
+        self._curve = curve
         self.endpoint = bind_provider(self._router, location,
                                       options.provider_bind,
                                       options.advertise_host)
@@ -52,23 +66,17 @@ class ZmqInbox(Inbox):
         except zmq.Again:
             return None
         data = router.recv() if router.getsockopt(_RCVMORE) else b""
-        extra = 0
-        while router.getsockopt(_RCVMORE):
-            router.recv()
-            extra += 1
+        frames = recv_rest(router, data) if router.getsockopt(_RCVMORE) else [data]
 
         def reply(msg: Message) -> None:
-            raw = encode(msg)
+            out = encode_frames(msg)
             router.send(identity, _MORE_NOBLOCK)
-            router.send(raw, _NOBLOCK)
+            send_frames(router, out, _NOBLOCK)
 
-        if extra:
-            self._rejected("inbox")
-            return Incoming(None, f"expected one message frame, got {extra + 1}", reply)
-        if data == self._token:
+        if len(frames) == 1 and data == self._token:
             return None
         try:
-            msg = decode(data, self._options.max_message, self._options.max_depth)
+            msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:  # answered with an error reply by the provider
             self._rejected("inbox")
             return Incoming(None, str(exc), reply)
@@ -80,6 +88,8 @@ class ZmqInbox(Inbox):
         except zmq.ZMQError:
             return  # context already gone: the receiver ends at its timeout anyway
         sock.setsockopt(zmq.LINGER, 1000)
+        if self._curve is not None:  # our own key is on the allow-list
+            self._curve.client(sock, self._curve.public)
         sock.connect(self._bound.replace("0.0.0.0", "127.0.0.1"))
         sock.send(self._token, zmq.NOBLOCK)
         sock.close()

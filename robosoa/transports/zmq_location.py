@@ -1,7 +1,12 @@
-"""The ZeroMQ location service process: location protocol on a ROUTER, plus the broker.
+"""The ZeroMQ location service process: location protocol on a ROUTER, announcements on a PUB.
 
-The broker is ZeroMQ's own XSUB/XPUB forwarder (``zmq.proxy_steerable``, C code, its own
-thread); the location protocol is answered by ``robosoa.location.LocationService``.
+There is no broker: publishers bind their own PUB sockets and register them here as
+``robosoa.pub`` entries; subscribers connect to them directly. Whenever the set of publishers
+changes, this process says so on its announcement PUB (``a:`` channel, no contents: a
+subscriber that hears it looks the publishers up again), so new publishers are found in
+milliseconds; a subscriber also looks them up every heartbeat, so nothing depends on an
+announcement arriving. The location protocol is answered by
+``robosoa.location.LocationService``.
 """
 
 from __future__ import annotations
@@ -17,8 +22,10 @@ import zmq
 
 from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
+from robosoa.transports import zmq_curve as curve
 from robosoa.transports.zmq_sockets import (
     check_endpoint,
+    keepalive,
     limit_input,
     location_request,
     split_endpoint,
@@ -28,6 +35,8 @@ from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_object
 log = logging.getLogger("robosoa.location")
 
 PEER_TIMEOUT = 0.3  # seconds a federated lookup may take before the peer is skipped
+LINK_HEARTBEAT, LINK_TIMEOUT = 1.0, 3.0  # ZMTP heartbeats, as BusOptions' defaults
+ANNOUNCE = b"a:\0"  # channel of "the publishers changed" announcements
 
 
 @dataclass(frozen=True, slots=True)
@@ -36,14 +45,14 @@ class LocationConfig:
     accepts from peers (every limit is documented in docs/security.md)."""
 
     bind: str
-    xsub: str = ""  # broker input (publishers connect); default: port + 1 or PATH.xsub
-    xpub: str = ""  # broker output (subscribers connect); default: port + 2 or PATH.xpub
+    announce: str = ""  # PUB of publisher-set changes; default: port + 1 or PATH.announce
     ttl: float = 3.0
     federate: tuple[str, ...] = ()
-    hwm: int = 1000  # broker queue per publisher (XSUB) and per subscriber (XPUB); then drops
-    max_message: int = MAX_MESSAGE  # bytes per frame from a peer, broker frames included
+    max_message: int = MAX_MESSAGE  # bytes per frame from a peer
     max_depth: int = MAX_DEPTH  # JSON nesting of one location request
     limits: Limits = field(default_factory=Limits)  # registrations, TTLs, federation
+    curve_secret: str = ""  # this service's certificate (NAME.key_secret); "" = no CURVE
+    curve_allow: str = ""  # folder of the public certificates allowed on the bus
 
 
 def _wild(endpoint: str) -> str:
@@ -51,24 +60,29 @@ def _wild(endpoint: str) -> str:
     return f"tcp://{host}:*" if scheme == "tcp" and port == 0 else endpoint
 
 
-def broker_binds(config: LocationConfig) -> tuple[str, str]:
-    """The XSUB and XPUB bind endpoints (explicit, or derived from the location endpoint)."""
+def announce_bind(config: LocationConfig) -> str:
+    """The announcement PUB's bind endpoint (explicit, or derived from the location's)."""
     scheme, where, port = split_endpoint(config.bind)
     if scheme == "ipc":
-        derived = (f"ipc://{where}.xsub", f"ipc://{where}.xpub")
+        derived = f"ipc://{where}.announce"
     elif port == 0:
-        derived = (f"tcp://{where}:*", f"tcp://{where}:*")
+        derived = f"tcp://{where}:*"
     else:
-        derived = (f"tcp://{where}:{port + 1}", f"tcp://{where}:{port + 2}")
-    return _wild(config.xsub or derived[0]), _wild(config.xpub or derived[1])
+        derived = f"tcp://{where}:{port + 1}"
+    return _wild(config.announce or derived)
 
 
 def _peer_of(frame: zmq.Frame) -> str:
-    """Who sent ``frame``: the remote host for tcp, the process for ipc (registry ownership)."""
-    try:
-        return str(frame.get("Peer-Address"))
-    except zmq.ZMQError:
-        return ""
+    """Who sent ``frame`` (registry ownership): its CURVE public key when the bus uses CURVE,
+    else the remote host for tcp, the process for ipc."""
+    for prop in ("User-Id", "Peer-Address"):
+        try:
+            found = str(frame.get(prop))
+        except zmq.ZMQError:
+            continue
+        if found and found != "anonymous":
+            return found
+    return ""
 
 
 class LocationServer:
@@ -76,29 +90,29 @@ class LocationServer:
 
     def __init__(self, config: LocationConfig) -> None:
         self.config = config
+        self.curve = curve.load(config.curve_secret, config.curve_allow, "", server=True)
+        if self.curve is not None and config.federate:
+            raise RobosoaError("--federate is not available with CURVE yet (a federated "
+                               "location service's key cannot be given)")
         self._ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
+        self._auth = self.curve.authenticator(self._ctx) if self.curve is not None else None
         self._sockets: list[zmq.Socket[bytes]] = []
         try:  # a bind that fails (bad address, port taken) releases what was bound before
             self._router = self._socket(zmq.ROUTER, _wild(config.bind))
-            xsub_bind, xpub_bind = broker_binds(config)
-            self._xsub = self._socket(zmq.XSUB, xsub_bind, config.hwm)
-            self._xpub = self._socket(zmq.XPUB, xpub_bind, config.hwm)
+            self._announce = self._socket(zmq.PUB, announce_bind(config))
         except BaseException:
-            for sock in self._sockets:
-                sock.close(0)
-            self._ctx.term()
+            self._release()
             raise
         self.endpoint = self._last(self._router)
-        self.broker = (self._last(self._xsub), self._last(self._xpub))
-        hello = {"transport": "zmq", "xsub": self.broker[0], "xpub": self.broker[1]}
+        self.announce = self._last(self._announce)
+        hello = {"transport": "zmq", "announce": self.announce}
         registry = Registry(default_ttl=config.ttl, limits=config.limits)
         self.service = LocationService(registry, self._peer, hello, name=self.endpoint,
                                        limits=config.limits)
         for address in config.federate:
             self.service.federate(address)
-        self._control = f"inproc://robosoa-proxy-{id(self)}"
         self._stop = threading.Event()
-        self._proxy = threading.Thread(target=self._run_proxy, daemon=True, name="robosoa-broker")
+        self._publishers = registry.publishers()
 
     def _socket(self, kind: int, bind: str, hwm: int = 1000) -> zmq.Socket[bytes]:
         check_endpoint(bind)
@@ -108,6 +122,9 @@ class LocationServer:
         sock.setsockopt(zmq.SNDHWM, hwm)
         sock.setsockopt(zmq.RCVHWM, hwm)
         limit_input(sock, self.config.max_message)
+        keepalive(sock, LINK_HEARTBEAT, LINK_TIMEOUT)
+        if self.curve is not None:
+            self.curve.serve(sock)
         try:
             sock.bind(bind)
         except zmq.ZMQError as exc:
@@ -134,15 +151,13 @@ class LocationServer:
 
         return lookup
 
-    def _run_proxy(self) -> None:
-        control = self._ctx.socket(zmq.PAIR)
-        control.connect(self._control)
-        try:
-            zmq.proxy_steerable(self._xsub, self._xpub, None, control)
-        except zmq.ContextTerminated:
-            pass
-        finally:
-            control.close(0)
+    def _announce_changes(self) -> None:
+        """Say on the announcement PUB that the publishers changed, if they did."""
+        now = self.service.registry.publishers()
+        if now != self._publishers:
+            self._publishers = now
+            with contextlib.suppress(zmq.ZMQError):
+                self._announce.send_multipart([ANNOUNCE, str(now).encode()], zmq.NOBLOCK)
 
     def _answer(self, frames: list[zmq.Frame]) -> None:
         """Answer one request; a malformed one gets an error reply and is counted."""
@@ -170,13 +185,9 @@ class LocationServer:
         return request
 
     def serve(self) -> None:
-        """Answer location requests and forward broker traffic until ``stop``."""
-        steer = self._ctx.socket(zmq.PAIR)
-        steer.bind(self._control)
-        self._proxy.start()
+        """Answer location requests and announce publisher changes until ``stop``."""
         log.info("location service started", extra={"endpoint": self.endpoint,
-                                                    "xsub": self.broker[0],
-                                                    "xpub": self.broker[1]})
+                                                    "announce": self.announce})
         try:
             while not self._stop.is_set():
                 if self._router.poll(200, zmq.POLLIN):
@@ -187,13 +198,16 @@ class LocationServer:
                         self.service.counter.fail()
                         log.exception("location request failed")
                 self.service.registry.expire()
+                self._announce_changes()
         finally:
-            steer.send(b"TERMINATE")
-            self._proxy.join(timeout=5.0)
-            steer.close(0)
-            for sock in (self._router, self._xsub, self._xpub):
-                sock.close(0)
-            self._ctx.term()
+            self._release()
+
+    def _release(self) -> None:
+        for sock in self._sockets:
+            sock.close(0)
+        if self._auth is not None:
+            self._auth.stop()
+        self._ctx.term()
 
     def stop(self) -> None:
         """Make ``serve`` return (thread-safe, signal-safe)."""

@@ -1,203 +1,292 @@
-"""Topics and events over the location service's XSUB/XPUB forwarder (the message broker).
-
-One PUB socket per bus (sends serialised by a lock; PUB never blocks: at its high-water mark
-ZeroMQ drops) and one SUB socket owned by a receiving thread that fans messages out to the
+"""The subscribing side of a bus over ZeroMQ: SUB sockets connected straight to every
+publisher (no broker in between), owned by a thread that fans messages out to the
 subscriptions' bounded queues.
+
+Two SUB sockets: one for publishers' best-effort PUBs, one for their reliable XPUBs. When a
+reliable subscription refuses a message (its queue is full), the thread keeps that message
+and stops reading the reliable socket until the subscription has room: ZeroMQ's queues and
+TCP then fill up to the publisher, whose reliable sends fail, so it waits instead of anything
+being dropped. The best-effort socket is read on meanwhile.
+
+Which publishers exist is learnt from the location service (``zmq_topics.Discovery``); once
+connected, messages flow whether or not the location service is alive. The best-effort SUB is
+also connected to the location service's announcements (``a:`` channel): one means "look the
+publishers up again".
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-import uuid
+import time
 from collections import deque
 from collections.abc import Callable
 
 import zmq
 
+from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
-from robosoa.message import Kind, Message, decode, encode
-from robosoa.transports.base import BusOptions, Sink
-from robosoa.transports.zmq_sockets import Waker, limit_input
+from robosoa.message import Message, decode_frames
+from robosoa.transports.base import BusOptions, Sink, offer_until
+from robosoa.transports.zmq_curve import Curve
+from robosoa.transports.zmq_outlet import MARK, META, prefix
+from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
 
 log = logging.getLogger("robosoa.zmq")
 
-PROBE = "robosoa.probe"  # context key of subscription-sync probes; never delivered to sinks
-SYNC_TIMEOUT = 2.0
-
-
-_NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every call
-_MORE_NOBLOCK = int(zmq.SNDMORE | zmq.NOBLOCK)
-_RCVMORE = int(zmq.RCVMORE)
-_FRAMES: dict[str, bytes] = {}
-
-
-def _frame(channel: str) -> bytes:
-    """The channel frame; the terminator turns ZeroMQ prefix matching into exact matching."""
-    frame = _FRAMES.get(channel)
-    if frame is None:
-        frame = channel.encode() + b"\0"
-        if len(_FRAMES) < 4096:  # a bounded cache of the channels in use
-            _FRAMES[channel] = frame
-    return frame
-
-
-def _receive(sub: zmq.Socket[bytes]) -> list[bytes]:
-    """One multipart message without pyzmq's generic loop (raises zmq.Again when empty)."""
-    frames = [sub.recv(_NOBLOCK)]
-    while sub.getsockopt(_RCVMORE):
-        frames.append(sub.recv(_NOBLOCK))
-    return frames
+ANNOUNCE = b"a:"  # the location service's channel of publisher-set changes
+MAX_TRACKED = 65536  # (publisher, channel) sequence numbers kept; then forgotten (no loss seen)
+_NOBLOCK = int(zmq.NOBLOCK)
 
 
 class Feed:
-    """The publish and subscribe side of one bus."""
+    """The SUB side of one bus; every socket operation happens on its own thread."""
 
-    def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], broker: tuple[str, str],
-                 options: BusOptions, rejected: Callable[[str], None]) -> None:
+    def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], options: BusOptions,
+                 rejected: Callable[[str], None], lost: Callable[[str, int], None],
+                 announce: str, announced: Callable[[], None],
+                 curve: Curve | None = None) -> None:
+        self._curve = curve
         self._ctx = ctx
-        self._broker = broker
         self._options = options
         self._rejected = rejected  # counts malformed broadcasts (dropped: nobody to answer)
-        self._pub = ctx.socket(zmq.PUB)
-        self._pub.setsockopt(zmq.LINGER, 0)
-        self._pub.setsockopt(zmq.SNDHWM, options.hwm)
-        self._pub.connect(broker[0])
-        self._pub_lock = threading.Lock()
-        self._sinks: dict[str, tuple[Sink, ...]] = {}  # replaced, never mutated: lock-free reads
+        self._lost = lost  # (channel, n): messages a publisher sent that never arrived
+        self._announced = announced
+        self._sinks: dict[bytes, tuple[Sink, ...]] = {}  # replaced, never mutated: lock-free
         self._lock = threading.Lock()
-        self._commands: deque[tuple[str, str]] = deque()
-        self._probes: dict[str, threading.Event] = {}
+        self._commands: deque[tuple[str, object, threading.Event | None]] = deque()
         self._waker = Waker(ctx)
-        self.unsent = 0  # publishes refused locally (never happens for PUB, kept for stats)
+        self._last: dict[tuple[int, bytes], int] = {}
+        self._held: tuple[Message, int, float, tuple[Sink, ...]] | None = None  # refused
         self._stopped = threading.Event()
+        self._announce = announce
         self._thread = threading.Thread(target=self._run, daemon=True, name="robosoa-sub")
         self._thread.start()
 
-    def publish(self, channel: str, raw: bytes) -> None:
-        """Send one message; ZeroMQ drops it for subscribers whose queues are full."""
-        with self._pub_lock:
-            try:
-                self._pub.send(_frame(channel), _MORE_NOBLOCK)
-                self._pub.send(raw, _NOBLOCK)
-            except zmq.Again:
-                self.unsent += 1
-
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
-        """Add ``sink`` for ``channel``; returns once the broker forwards the channel to us."""
+        """Add ``sink`` for ``channel``; returns once the SUB socket subscribes to it."""
+        key = prefix(channel)[:-1]
         with self._lock:
-            sinks = self._sinks.get(channel, ())
+            sinks = self._sinks.get(key, ())
             first = not sinks
-            self._sinks[channel] = (*sinks, sink)
+            self._sinks[key] = (*sinks, sink)
         if first:
-            self._command("sub", channel)
-            self._sync(channel)
+            self._command("sub", key, wait=True)
 
         def cancel() -> None:
             with self._lock:
-                sinks = tuple(s for s in self._sinks.get(channel, ()) if s is not sink)
+                sinks = tuple(s for s in self._sinks.get(key, ()) if s is not sink)
                 last = not sinks
                 if last:
-                    self._sinks.pop(channel, None)
+                    self._sinks.pop(key, None)
                 else:
-                    self._sinks[channel] = sinks
+                    self._sinks[key] = sinks
             if last:
-                self._command("unsub", channel)
+                self._command("unsub", key)
 
         return cancel
 
-    def _sync(self, channel: str) -> None:
-        """Publish probes on ``channel`` until one comes back through the broker."""
-        token = uuid.uuid4().hex
-        arrived = self._probes[token] = threading.Event()
-        probe = encode(Message(Kind.EVENT, topic=channel, context={PROBE: token}))
-        try:
-            for _ in range(int(SYNC_TIMEOUT / 0.02)):
-                self.publish(channel, probe)
-                if arrived.wait(0.02) or self._stopped.is_set():
-                    return
-            log.warning("subscription not confirmed by the broker", extra={"channel": channel})
-        finally:
-            self._probes.pop(token, None)
+    def connect(self, endpoints: tuple[dict[str, str], dict[str, str]],
+                wait: bool = False) -> None:
+        """Be connected to exactly these publishers' best-effort and reliable endpoints
+        (each with its CURVE key, "" without CURVE)."""
+        self._command("peers", endpoints, wait)
 
-    def move(self, broker: tuple[str, str]) -> None:
-        """Reconnect to a broker at new endpoints (restarted location service)."""
-        with self._pub_lock:
-            self._pub.disconnect(self._broker[0])
-            self._pub.connect(broker[0])
-        self._command("move", broker[1])
-        self._broker = broker
+    def room(self) -> None:
+        """A reliable subscription has room again: offer the held-back message again."""
+        self._command("room", None)
 
-    def _command(self, op: str, arg: str) -> None:
-        self._commands.append((op, arg))
+    def move(self, announce: str) -> None:
+        """Follow the location service's announcements to a new endpoint."""
+        self._command("move", announce)
+
+    def _command(self, op: str, arg: object, wait: bool = False) -> None:
+        done = threading.Event() if wait else None
+        self._commands.append((op, arg, done))
         self._waker.wake()
+        if done is not None and not done.wait(2.0) and not self._stopped.is_set():
+            log.warning("subscriber thread is slow to take a command", extra={"op": op})
 
-    def _apply(self, sub: zmq.Socket[bytes], endpoint: str) -> str:
+    def _apply(self, subs: tuple[zmq.Socket[bytes], zmq.Socket[bytes]],
+               peers: tuple[set[str], set[str]]) -> None:
         while self._commands:
-            op, arg = self._commands.popleft()
-            if op == "sub":
-                sub.setsockopt(zmq.SUBSCRIBE, _frame(arg))
-            elif op == "unsub":
-                sub.setsockopt(zmq.UNSUBSCRIBE, _frame(arg))
-            elif op == "move":
-                sub.disconnect(endpoint)
-                sub.connect(arg)
-                endpoint = arg
-        return endpoint
+            op, arg, done = self._commands.popleft()
+            try:
+                if op in ("sub", "unsub") and isinstance(arg, bytes):
+                    for sub in subs:
+                        sub.setsockopt(zmq.SUBSCRIBE if op == "sub" else zmq.UNSUBSCRIBE,
+                                       arg + b"\0")
+                    if op == "unsub":  # a later subscription starts counting afresh
+                        self._last = {k: v for k, v in self._last.items() if k[1] != arg}
+                elif op == "peers" and isinstance(arg, tuple):
+                    for sub, have, want in zip(subs, peers, arg, strict=True):
+                        self._follow(sub, have, want)
+                elif op == "move" and isinstance(arg, str):
+                    _quietly(subs[0].disconnect, self._announce)
+                    self._announce = arg
+                    self._connect(subs[0], arg, self._curve.location if self._curve else b"")
+                elif op == "room":
+                    self._retry()
+            finally:
+                if done is not None:
+                    done.set()
 
-    def _deliver(self, frames: list[bytes]) -> None:
-        if len(frames) != 2:
+    def _retry(self) -> None:
+        """Offer the held-back message to the sinks that refused it (feed thread)."""
+        if self._held is not None:
+            msg, size, expires, sinks = self._held
+            waiting = tuple(s for s in sinks if not s(msg, size, expires, True))
+            self._held = (msg, size, expires, waiting) if waiting else None
+
+    def local(self, channel: str, frames: list[bytes], expires: float,
+              block: float | None) -> None:
+        """A message this bus published itself: to its own subscriptions, on the caller's
+        thread (a bus never listens to its own PUB, so no message comes twice); a reliable
+        one waits for room up to ``block`` seconds (PublishTimeout)."""
+        sinks = self._sinks.get(prefix(channel)[:-1])
+        if sinks:
+            msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
+            size = sum(map(len, frames))
+            if block is None:
+                for sink in sinks:
+                    sink(msg, size, expires, False)
+                return
+            deadline = time.monotonic() + block
+            for sink in sinks:
+                offer_until(sink, (msg, size, expires), deadline, channel)
+
+    def _deliver(self, frames: list[bytes], hold: bool) -> bool:
+        """Hand one message to its sinks; False if a reliable one refused it (held back:
+        only for messages of the reliable socket, ``hold``)."""
+        head = frames[0]
+        cut = head.find(b"\0")
+        channel = head[:cut]
+        if channel == ANNOUNCE:
+            self._announced()
+            return True
+        if cut < 0 or len(head) < cut + 1 + META.size:
             self._rejected("broadcast")
-            return
+            return True
+        sinks = self._sinks.get(channel)
+        if sinks is None:
+            return True
+        publisher, seq, expires = META.unpack_from(head, cut + 1)
+        self._sequence(publisher, channel, seq, expires == MARK)
+        if expires == MARK:
+            return True
+        body = head[cut + 1 + META.size:]
         try:
-            msg = decode(frames[1], self._options.max_message, self._options.max_depth)
+            msg = decode_frames([body, *frames[1:]] if len(frames) > 1 else [body],
+                                self._options.max_message, self._options.max_depth)
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
-            return
-        token = msg.context.get(PROBE)
-        if token is not None:
-            event = self._probes.get(str(token))
-            if event is not None:
-                event.set()
-            return
-        for sink in self._sinks.get(frames[0][:-1].decode(errors="replace"), ()):
-            sink(msg)
+            return True
+        size = len(head) if len(frames) == 1 else sum(map(len, frames))
+        refused: tuple[Sink, ...]
+        if len(sinks) == 1:
+            if sinks[0](msg, size, expires, hold):
+                return True
+            refused = sinks
+        else:
+            refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
+            if not refused:
+                return True
+        self._held = (msg, size, expires, refused)
+        return False
 
-    def _run(self) -> None:
+    def _sequence(self, publisher: int, channel: bytes, seq: int, mark: bool) -> None:
+        """Count the messages of ``publisher`` on ``channel`` that were skipped (up to its
+        message ``seq``, or up to and with ``seq`` for a mark)."""
+        key = (publisher, channel)
+        last = self._last.get(key)
+        if last is None and len(self._last) >= MAX_TRACKED:
+            self._last.clear()
+        if last is not None and seq > last:
+            missing = seq - last - (0 if mark else 1)
+            if missing > 0:
+                self._lost(channel.decode(errors="replace"), missing)
+        if last is None or seq > last or not mark:
+            self._last[key] = seq
+
+    def _socket(self) -> zmq.Socket[bytes]:
         sub = self._ctx.socket(zmq.SUB)
         sub.setsockopt(zmq.LINGER, 0)
         sub.setsockopt(zmq.RCVHWM, self._options.hwm)
         limit_input(sub, self._options.max_message)
-        endpoint = self._broker[1]
-        sub.connect(endpoint)
+        keepalive(sub, self._options.link_heartbeat, self._options.link_timeout)
+        return sub
+
+    def _run(self) -> None:
+        lossy, reliable = self._socket(), self._socket()
+        lossy.setsockopt(zmq.SUBSCRIBE, ANNOUNCE + b"\0")
+        self._connect(lossy, self._announce, self._curve.location if self._curve else b"")
+        peers: tuple[set[str], set[str]] = (set(), set())
         poller = zmq.Poller()
-        poller.register(sub, zmq.POLLIN)
-        poller.register(self._waker.rx, zmq.POLLIN)
+        for sock in (lossy, reliable, self._waker.rx):
+            poller.register(sock, zmq.POLLIN)
+        paused = False
         try:
             while not self._stopped.is_set():
                 events = dict(poller.poll(500))
                 if self._waker.rx in events:
                     self._waker.drain()
-                    endpoint = self._apply(sub, endpoint)
-                if sub in events:
-                    for _ in range(256):  # drain a batch, then look at commands again
-                        try:
-                            frames = _receive(sub)
-                        except zmq.Again:
-                            break
-                        try:
-                            self._deliver(frames)
-                        except Exception:  # never let one message end the subscriber thread
-                            log.exception("broadcast delivery failed")
+                    self._apply((lossy, reliable), peers)
+                if lossy in events:
+                    self._drain(lossy, False)
+                if reliable in events and self._held is None:
+                    self._drain(reliable, True)
+                if paused != (self._held is not None):  # hold the reliable socket back
+                    paused = not paused
+                    poller.modify(reliable, 0 if paused else zmq.POLLIN)
         finally:
-            sub.close(0)
+            lossy.close(0)
+            reliable.close(0)
+            while self._commands:  # nobody waits on a command that will never run
+                done = self._commands.popleft()[2]
+                if done is not None:
+                    done.set()
+
+    def _drain(self, sub: zmq.Socket[bytes], hold: bool) -> None:
+        """Deliver a batch of what ``sub`` holds; stop early at a held-back message."""
+        for _ in range(256):  # then look at commands again
+            try:
+                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+            except zmq.Again:
+                return
+            try:
+                if not self._deliver(frames, hold):
+                    return
+            except Exception:  # never let one message end the subscriber thread
+                log.exception("broadcast delivery failed")
+
+    def _follow(self, sub: zmq.Socket[bytes], have: set[str], want: dict[str, str]) -> None:
+        """Connect ``sub`` to the endpoints of ``want`` it lacks, disconnect the others."""
+        for gone in have - want.keys():
+            _quietly(sub.disconnect, gone)
+        for new in want.keys() - have:
+            self._connect(sub, new, want[new].encode())
+        have.clear()
+        have.update(want)
+
+    def _connect(self, sub: zmq.Socket[bytes], endpoint: str, key: bytes) -> None:
+        """Connect, as a CURVE client of ``key`` when the bus uses CURVE."""
+        if self._curve is not None:
+            self._curve.client(sub, key)
+        _quietly(sub.connect, endpoint)
 
     def close(self) -> None:
-        """Stop the receiving thread and close both sockets."""
+        """Stop the receiving thread and close its socket."""
         self._stopped.set()
         self._waker.wake()
         self._thread.join(timeout=5.0)
-        with self._pub_lock:
-            self._pub.close(0)
         self._waker.close()
+
+
+def _quietly(call: Callable[[str], object], endpoint: str) -> None:
+    """Connect or disconnect, logging an endpoint ZeroMQ refuses (a peer's bad entry)."""
+    try:
+        call(endpoint)
+    except zmq.ZMQError as exc:
+        log.warning("publisher endpoint refused", extra={"endpoint": endpoint[:200],
+                                                         "reason": str(exc)})

@@ -11,10 +11,12 @@ import socket
 import tempfile
 import threading
 import uuid
+from collections.abc import Sequence
 from typing import Any
 
 import zmq
 
+from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.wire import MAX_MESSAGE, load_object
 
@@ -59,6 +61,45 @@ def check_endpoint(endpoint: str) -> str:
         raise RobosoaError(f"bad ZeroMQ endpoint {endpoint!r}: {host!r} is not an IP address "
                            "or host name") from None
     return endpoint
+
+
+_SNDMORE = int(zmq.SNDMORE)
+_RCVMORE = int(zmq.RCVMORE)
+
+
+def send_frames(sock: zmq.Socket[bytes], frames: Sequence[bytes], flags: int = 0) -> None:
+    """Send ``frames`` as one message; large frames without a copy (pyzmq copies frames
+    below its ``copy_threshold`` anyway). ZeroMQ takes a multipart message whole or not at
+    all, so only the first send can raise ``zmq.Again``."""
+    last = len(frames) - 1
+    sock.send(frames[0], flags | _SNDMORE if last else flags)
+    for n in range(1, last + 1):
+        sock.send(frames[n], flags | _SNDMORE if n < last else flags, copy=False)
+
+
+def recv_rest(sock: zmq.Socket[bytes], first: bytes,
+              limit: int = MAX_BLOBS + 1) -> list[bytes]:
+    """``first`` and the other frames of the message it began (already arrived, whole).
+
+    Frames past ``limit`` are read and thrown away, so a message of too many frames comes
+    back as ``limit + 1`` frames, which the decoder refuses.
+    """
+    frames = [first]
+    while sock.getsockopt(_RCVMORE):
+        frame = sock.recv()
+        if len(frames) <= limit:
+            frames.append(frame)
+    return frames
+
+
+def keepalive(sock: zmq.Socket[bytes], heartbeat: float, timeout: float) -> None:
+    """ZMTP heartbeats: a PING every ``heartbeat`` s; a connection that brings nothing back
+    for ``timeout`` s is closed (also asked of the peer, as the TTL), so a dead or cut-off
+    peer is noticed by ZeroMQ itself, not at the end of a request's timeout. 0 turns it off."""
+    if heartbeat > 0:
+        sock.setsockopt(zmq.HEARTBEAT_IVL, max(1, int(heartbeat * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TIMEOUT, max(1, int(timeout * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TTL, min(6_553_599, max(100, int(timeout * 1000))))
 
 
 def limit_input(sock: zmq.Socket[bytes], max_message: int) -> None:

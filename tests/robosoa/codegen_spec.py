@@ -27,8 +27,8 @@ CLIENT_IMPORTS = {"annotations", "sys", "Callable", "Sequence", "Any", "robosoa"
                   "VERSION"}
 PROVIDER_IMPORTS = {"annotations", "argparse", "ctypes", "importlib", "sys", "Sequence", "Any",
                     "Protocol", "robosoa", "ExecutableRunner", "payload_of", "serve_main",
-                    "to_wire", "check_platform", "DESCRIPTOR", "OPERATIONS", "SERVICE",
-                    "VERSION"}
+                    "to_wire", "check_platform", "DESCRIPTOR", "OPERATIONS", "IDEMPOTENT",
+                    "SERVICE", "VERSION"}
 API_IMPORTS = {"annotations", "os", "robosoa"}
 
 
@@ -57,7 +57,8 @@ def type_classes(d: ServiceDescriptor) -> set[str]:
 
 def _types(d: ServiceDescriptor) -> Expected:
     classes = type_classes(d)
-    top = {"SERVICE", "VERSION", "PATTERN", "OPERATIONS", "DESCRIPTOR_XML", "DESCRIPTOR"}
+    top = {"SERVICE", "VERSION", "PATTERN", "OPERATIONS", "IDEMPOTENT", "DESCRIPTOR_XML",
+           "DESCRIPTOR"}
     methods = {"from_payload", "to_payload"} if classes else set()
     return Expected(frozenset(top | classes), frozenset(TYPES_IMPORTS),
                     frozenset(classes | methods))

@@ -111,12 +111,40 @@ SENSOR = """\
     <struct name="Pose"><field name="x" type="float"/><field name="y" type="float"/></struct>
   </types>
   <operation name="reading">
+    <qos depth="10" lifespan="30" max-bytes="65536"/>
     <param name="value" type="float"/><param name="unit" type="string" default="m"/>
     <param name="where" type="Pose" required="false"/>
   </operation>
   <operation name="heartbeat"/>
   <participant actor="provider" packaging="provider-library"/>
   <participant actor="consumer" packaging="consumer-source"/>
+</service>
+"""
+
+CAMERA = """\
+<service name="camera" version="1.0.0">
+  <pattern>request-response</pattern>
+  <types>
+    <struct name="Image">
+      <field name="pixels" type="bytes"/><field name="width" type="int"/>
+    </struct>
+  </types>
+  <operation name="snap" idempotent="true">
+    <param name="mask" type="bytes"/>
+    <param name="tiles" type="list[bytes]" required="false"/>
+    <return name="image" type="Image"/>
+    <return name="thumbs" type="list[bytes]"/>
+  </operation>
+  <participant actor="provider" packaging="provider-library">
+    <implementation form="library" library="camera_impl"/>
+  </participant>
+  <participant actor="consumer" packaging="consumer-source"/>
+  <participant actor="provider" packaging="provider-executable">
+    <implementation form="executable" encoding="json">
+      <command>{python} camera_prog.py</command>
+    </implementation>
+    <naming package="camera_exec"/>
+  </participant>
 </service>
 """
 
@@ -143,6 +171,7 @@ def descriptors() -> dict[str, str]:
         "wdb.xml": EXAMPLE.read_text(),
         "inventory.xml": INVENTORY.replace("{python}", python),
         "calc.xml": CALC.replace("{python}", python),
+        "camera.xml": CAMERA.replace("{python}", python),
         "sensor.xml": SENSOR.format(name="sensor", pattern="publish-subscribe"),
         "alarm.xml": SENSOR.format(name="alarm", pattern="event"),
         "motor.xml": MOTOR.format(

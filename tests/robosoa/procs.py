@@ -90,11 +90,10 @@ def start_location(bind: str, *extra: str) -> tuple[Proc, str]:
 
 
 def tcp_location(*extra: str) -> tuple[Proc, str]:
-    """A location service on three free 127.0.0.1 ports."""
-    ports = [free_port() for _ in range(3)]
+    """A location service on two free 127.0.0.1 ports (requests, announcements)."""
+    ports = [free_port() for _ in range(2)]
     return start_location(f"tcp://127.0.0.1:{ports[0]}",
-                          "--xsub", f"tcp://127.0.0.1:{ports[1]}",
-                          "--xpub", f"tcp://127.0.0.1:{ports[2]}", *extra)
+                          "--announce", f"tcp://127.0.0.1:{ports[1]}", *extra)
 
 
 PROVIDER = textwrap.dedent('''
@@ -121,5 +120,91 @@ PROVIDER = textwrap.dedent('''
 def start_provider(url: str, name: str, version: str = "1.0.0", group: str = "") -> Proc:
     """A provider of ``name`` in its own process (operations echo, note, seen)."""
     proc = Proc([PYTHON, "-c", PROVIDER, url, name, version, group])
+    proc.wait_line("ready")
+    return proc
+
+
+WORKER = textwrap.dedent('''
+    import os, signal, sys, threading, time, robosoa
+    url, name, role, idempotent, advertise = sys.argv[1:6]
+    where = {"provider_bind": "tcp://127.0.0.1", "advertise_host": advertise} if advertise else {}
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0, **where)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    def work(n):
+        if role == "victim":
+            print("busy", n, flush=True)
+            stop.wait(60)
+        return {"pid": os.getpid(), "n": n, "role": role}
+    bus.provide(name, {"work": work}, idempotent=("work",) if idempotent == "yes" else ())
+    print("ready", os.getpid(), flush=True)
+    stop.wait()
+    bus.close()
+''')
+
+
+def start_worker(url: str, name: str, role: str, idempotent: bool,
+                 advertise: str = "") -> Proc:
+    """A provider of ``name`` whose ``work`` hangs (role ``victim``: prints ``busy`` first)
+    or answers at once (``spare``); ``work`` is registered idempotent or not. With
+    ``advertise`` (e.g. 127.0.0.2) it binds 127.0.0.1 and registers that host instead, so
+    consumers reach it only through a relay listening there."""
+    proc = Proc([PYTHON, "-c", WORKER, url, name, role, "yes" if idempotent else "no",
+                 advertise])
+    proc.wait_line("ready")
+    return proc
+
+
+TICKER = textwrap.dedent('''
+    import os, signal, sys, threading, robosoa
+    url, topic, every, lifespan, advertise = sys.argv[1:6]
+    where = {"provider_bind": "tcp://127.0.0.1", "advertise_host": advertise} if advertise else {}
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0, **where)
+    every = float(every)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    bus.advertise(topic, robosoa.QoS(lifespan=float(lifespan)))
+    print("ready", os.getpid(), flush=True)
+    n = 0
+    while not stop.wait(every):
+        n += 1
+        bus.publish(topic, {"n": n, "pid": os.getpid()})
+    bus.close()
+''')
+
+
+def start_ticker(url: str, topic: str, every: float = 0.02, lifespan: float = 0.0,
+                 advertise: str = "") -> Proc:
+    """A process publishing ``{"n": 1, 2, ...}`` on ``topic`` every ``every`` seconds, with
+    that ``lifespan`` (0: none); ``advertise`` as for ``start_worker``."""
+    proc = Proc([PYTHON, "-c", TICKER, url, topic, str(every), str(lifespan), advertise])
+    proc.wait_line("ready")
+    return proc
+
+
+FLOODER = textwrap.dedent('''
+    import os, signal, sys, threading, robosoa
+    url, topic, count, size, go = sys.argv[1:6]
+    count, size = int(count), int(size)
+    bus = robosoa.connect(url, heartbeat=0.2, ttl=1.0)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    bus.advertise(topic)
+    print("ready", flush=True)
+    while not os.path.exists(go) and not stop.wait(0.02):
+        bus.publish(topic + "-probe", {})
+    data = os.urandom(size)
+    for n in range(count):
+        bus.publish(topic, {"n": n, "data": data})
+    print("sent", count, flush=True)
+    stop.wait()
+    bus.close()
+''')
+
+
+def start_flooder(url: str, topic: str, count: int, size: int, go: str) -> Proc:
+    """A process that publishes probes on ``topic-probe`` until the file ``go`` exists, then
+    ``count`` messages of ``size`` random bytes on ``topic`` as fast as it can."""
+    proc = Proc([PYTHON, "-c", FLOODER, url, topic, str(count), str(size), go])
     proc.wait_line("ready")
     return proc

@@ -45,12 +45,13 @@ def test_location_refuses_a_port_in_use() -> None:
         taken.listen()
         port = taken.getsockname()[1]
         refused(run("location", "--bind", f"tcp://127.0.0.1:{port}",
-                    "--xsub", f"tcp://127.0.0.1:{free_port()}",
-                    "--xpub", f"tcp://127.0.0.1:{free_port()}"), "cannot bind")
+                    "--announce", f"tcp://127.0.0.1:{free_port()}"), "cannot bind")
+        refused(run("location", "--bind", f"tcp://127.0.0.1:{free_port()}",
+                    "--announce", f"tcp://127.0.0.1:{port}"), "cannot bind")
 
 
 @pytest.mark.parametrize(("flag", "value"), [
-    ("--ttl", "nan"), ("--ttl", "-1"), ("--max-ttl", "inf"), ("--hwm", "0"),
+    ("--ttl", "nan"), ("--ttl", "-1"), ("--max-ttl", "inf"), ("--announce", "tcp://x:99999"),
     ("--max-message", "-5"), ("--max-entries", "0"), ("--federation-timeout", "nan"),
     ("--federate", "tcp://999.0.0.1:1"),
 ])

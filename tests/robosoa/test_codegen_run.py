@@ -95,6 +95,24 @@ void tick(void) { ticks++; }
 int64_t count(void) { return ticks; }
 """
 
+CAMERA_IMPL = """
+from camera_provider.types import Image, SnapResult
+
+
+def snap(mask: bytes, tiles: tuple[bytes, ...] | None = None) -> SnapResult:
+    pixels = bytes(b ^ m for b, m in zip(bytes(range(256)) * 4096, mask * 1048576))
+    return SnapResult(image=Image(pixels=pixels, width=1024), thumbs=(tiles or ())[::-1])
+"""
+
+CAMERA_PROG = """
+import base64, json, sys
+args = json.load(sys.stdin)
+mask = base64.b64decode(args["mask"])
+tiles = [base64.b64decode(t) for t in args.get("tiles", [])]
+json.dump({"image": {"pixels": base64.b64encode(mask * 3).decode(), "width": 3},
+           "thumbs": [base64.b64encode(t + b"!").decode() for t in tiles]}, sys.stdout)
+"""
+
 WDB_QUERY = """
 import sys
 request = sys.stdin.read()
@@ -128,6 +146,8 @@ def out(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
         "inventory_impl.py": INVENTORY_IMPL,
         "inventory_prog.py": INVENTORY_PROG,
         "calc_prog.py": CALC_PROG,
+        "camera_impl.py": CAMERA_IMPL,
+        "camera_prog.py": CAMERA_PROG,
         "wdb_query.py": WDB_QUERY,
         "wdb_update.py": WDB_UPDATE,
         "motor_impl.py": MOTOR_IMPL,
@@ -233,6 +253,30 @@ def test_provider_executable_with_json_and_a_failing_program(
         client.greet("x")
 
 
+def test_bytes_travel_typed_through_a_library_and_an_executable(
+    out: Path, buses: tuple[robosoa.Bus, robosoa.Bus]
+) -> None:
+    provider, consumer = buses
+    library = load_module("camera_provider.provider")
+    library.CameraProvider(library.CameraProviderLibrary()).provide(provider)
+    client = load_module("camera_client.client").CameraClient(consumer)
+    found = client.snap(b"\x01", tiles=(b"a", b"\x00\xff"))
+    assert found.image.width == 1024 and len(found.image.pixels) == 1024 * 1024
+    assert found.image.pixels[:3] == b"\x01\x00\x03" and found.thumbs == (b"\x00\xff", b"a")
+    with pytest.raises(robosoa.InvalidMessage, match="parameter 'mask': expected bytes, got str"):
+        client.snap("not bytes")
+    provider.close()
+    program = load_module("camera_exec.provider")
+    other = robosoa.connect(consumer.adapter.address)
+    try:
+        program.CameraProvider(program.CameraProviderExecutable(str(out))).provide(other)
+        found = load_module("camera_client.client").CameraClient(consumer, timeout=20.0).snap(
+            b"\xfe\x00", tiles=(b"\x80",))
+        assert found.image.pixels == b"\xfe\x00" * 3 and found.thumbs == (b"\x80!",)
+    finally:
+        other.close()
+
+
 @pytest.fixture(scope="module")
 def libcalc(out: Path) -> Path:
     compiler = shutil.which("cc") or shutil.which("gcc")
@@ -290,8 +334,10 @@ def test_publish_subscribe_and_events_deliver_typed_messages(
     beats: list[bool] = []
     subscriptions = [
         client.on_reading(readings.append),
-        client.on_heartbeat(lambda: beats.append(True)),
+        client.on_heartbeat(lambda: beats.append(True), qos=robosoa.QoS(keep_latest=True)),
     ]
+    assert subscriptions[0].qos == robosoa.QoS(depth=10, lifespan=30.0, max_bytes=65536)
+    assert subscriptions[1].qos.keep_latest  # overridden in code
     publisher = getattr(load_module(f"{service}_provider.provider"), f"{cap}Provider")(
         publisher_bus
     )

@@ -17,7 +17,7 @@ from robosoa.transports.zmq_location import PEER_TIMEOUT
 from robosoa.wire import MAX_DEPTH
 from tests.robosoa.conftest import FAST
 from tests.robosoa.procs import free_port, tcp_location
-from tests.robosoa.util import eventually
+from tests.robosoa.util import eventually, raw_publisher
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.slow]
 
@@ -159,10 +159,7 @@ def test_malformed_broadcasts_are_dropped_counted_and_harmless(zmq_url: str, nam
     with robosoa.connect(zmq_url, **FAST) as bus:
         got: list[robosoa.Message] = []
         bus.subscribe(name, got.append)
-        xsub = str(bus.adapter.location({"op": "hello"}, 2.0)["xsub"])
-        pub = ctx.socket(zmq.PUB)
-        pub.setsockopt(zmq.LINGER, 0)
-        pub.connect(xsub)
+        pub = raw_publisher(ctx, bus, f"junk-{name}")
         channel = f"t:{name}\0".encode()
         try:
             def flood() -> int:
@@ -172,7 +169,7 @@ def test_malformed_broadcasts_are_dropped_counted_and_harmless(zmq_url: str, nam
                 found = figures.get(("wire", "broadcast"))
                 return found.errors if found else 0
 
-            eventually(flood)  # a fresh PUB loses messages until the broker knows it
+            eventually(flood)  # until the subscriber has found and joined the raw PUB
             bus.publish(name, {"ok": 1})
             eventually(lambda: got)
             assert got[-1].payload == {"ok": 1}

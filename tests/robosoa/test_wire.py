@@ -77,3 +77,45 @@ def test_accepts_exactly_what_fits_the_limit(value: object, limit: int) -> None:
     else:
         with pytest.raises(LimitExceeded):
             load_json(raw, max_depth=limit)
+
+
+def _both(raw: bytes) -> tuple[object, object]:
+    """What the fast reading and json's own give for ``raw`` (or the error's type)."""
+    out: list[object] = []
+    for fast in (True, False):
+        try:
+            out.append(("ok", load_json(raw, fast=fast)))
+        except InvalidMessage as exc:
+            out.append(("error", type(exc).__name__, str(exc)))
+    return out[0], out[1]
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False)
+    | st.text(max_size=20),
+    lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=8), inner,
+                                                                max_size=5),
+    max_leaves=30)
+
+
+@settings(max_examples=300, deadline=None)
+@given(JSON_VALUES)
+def test_the_fast_reading_gives_what_json_gives(value: object) -> None:
+    raw = json.dumps(value).encode()  # big integers, infinities spelt as json spells them
+    fast, standard = _both(raw)
+    assert fast == standard
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=60) | st.text(max_size=40).map(str.encode))
+def test_the_fast_reading_refuses_what_json_refuses(raw: bytes) -> None:
+    fast, standard = _both(raw)
+    assert fast == standard
+
+
+@pytest.mark.parametrize("raw", [b'{"a": 123456789012345678901234567890}', b'{"a": 1e400}',
+                                 b'{"a": "\\ud800"}', b'{"a": -9223372036854775809}',
+                                 b"\xef\xbb\xbf{}", b'{"a": NaN}', b"[" * 2000 + b"]" * 2000])
+def test_where_orjson_and_json_differ_json_decides(raw: bytes) -> None:
+    fast, standard = _both(raw)
+    assert fast == standard

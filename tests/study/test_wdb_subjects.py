@@ -392,7 +392,7 @@ def test_soa_stage_on_zmq_bus(stage: str, tmp_path: Path, procs: list[Proc]) -> 
     bus = f"zmq://{location}"
     procs.append(Proc([sys.executable, "-c", "import sys; from robosoa.cli import main; "
                        "sys.exit(main())", "location", "--bind", location,
-                       "--xsub", "tcp://127.0.0.1:0", "--xpub", "tcp://127.0.0.1:0"],
+                       "--announce", "tcp://127.0.0.1:0"],
                       tmp_path, env, tmp_path / "location.log"))
     procs[-1].wait_line("location service")
     procs.append(Proc([sys.executable, "-m", "service.data_service_main", "--bus", bus,
