@@ -354,3 +354,21 @@ def test_summary_charts_draw_base_plus_framework_when_asked_and_say_so(
                 assert all_value.number == pytest.approx(getattr(summaries["total"], field))
                 differs |= value.number != all_value.number
     assert differs  # the study's new location changes: the two scopes are not the same chart
+
+
+def test_clip_paths_are_named_by_order_of_use_not_by_matplotlibs_hash() -> None:
+    """matplotlib names a clip path by a hash of its transform's repr, whose last float
+    digits two renders of one chart could differ in (the suite met it): two SVGs that
+    differ only there read the same."""
+    from archmetrics.reports.charts_draw import _numbered_clips
+
+    def svg(first: str, second: str) -> bytes:
+        return (
+            f'<g clip-path="url(#{first})"/><g clip-path="url(#{second})"/>'
+            f'<g clip-path="url(#{first})"/><defs><clipPath id="{first}"><rect/></clipPath>'
+            f'<clipPath id="{second}"><rect/></clipPath></defs>'
+        ).encode()
+
+    one = _numbered_clips(svg("pa2a0d10565", "p0325ac77b5"))
+    assert one == _numbered_clips(svg("pcbc7db0b36", "p26b6255de6"))
+    assert one.count(b"url(#clip0)") == 2 and b'clipPath id="clip1"' in one
