@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from bisect import bisect_left
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
@@ -249,14 +250,25 @@ def _patched(
 
 def _merged(origin: Side, delta: Delta, fresh: Mapping[str, FileRow]) -> tuple[FileRow, ...]:
     """``origin``'s rows with the delta's: its removed and its changed paths taken out, the
-    rows of the changed files that have a language put in (in path order, as a snapshot
-    lists its files); an unchanged file keeps ``origin``'s row."""
-    gone = delta.removed | {f.path for f in delta.changed}
-    kept = [row for row in origin.state.rows if row.path not in gone]
-    for path, row in fresh.items():
-        before = origin.by_path.get(path)
-        kept.append(before if before is not None and before == row else row)
-    return tuple(sorted(kept, key=lambda row: row.path))
+    rows of the changed files that have a language put in, each where it sorts (a snapshot
+    lists its files in path order); an unchanged file keeps ``origin``'s row."""
+    rows = list(origin.state.rows)
+    for path in sorted(delta.removed | {f.path for f in delta.changed}):
+        at = bisect_left(rows, path, key=_path)
+        found = at < len(rows) and rows[at].path == path
+        row = fresh.get(path)
+        if row is None:
+            if found:
+                del rows[at]
+        elif not found:
+            rows.insert(at, row)
+        elif rows[at] != row:
+            rows[at] = row
+    return tuple(rows)
+
+
+def _path(row: FileRow) -> str:
+    return row.path
 
 
 def _patched_index(

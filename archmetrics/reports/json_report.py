@@ -128,6 +128,8 @@ def dumps(document: dict[str, Any]) -> str:
     separators and lone surrogates are escaped here too (``\\u0085``), so the text is valid
     UTF-8 and safe to print (docs/security.md)."""
     text = _indented(document)
+    if text.isascii() and "\x7f" not in text:  # nothing to escape (C-speed checks: a tree
+        return text  # of 28,000 elements is 18 MB of JSON, and the pattern's pass 20 ms)
     return _UNPRINTABLE.sub(lambda found: f"\\u{ord(found.group()):04x}", text)
 
 
