@@ -15,12 +15,13 @@ import re
 import subprocess
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-
-import git as gitpython
-from git.exc import GitCommandError
+from typing import TYPE_CHECKING
 
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import SourceFile
+
+if TYPE_CHECKING:  # GitPython costs 45 ms to import: only the commands that read git do
+    import git as gitpython
 
 NO_BLOB = "0" * 40  # git's name for content it did not hash (a work tree file it saw change)
 _REGULAR = frozenset({"100644", "100755"})
@@ -56,6 +57,8 @@ class _Git:
         return command, process
 
     def finish(self, started: tuple[list[str], subprocess.Popen[bytes]]) -> bytes:
+        from git.exc import GitCommandError
+
         from archmetrics.sources.git import explain
 
         command, process = started
