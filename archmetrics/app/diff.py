@@ -12,7 +12,12 @@ from pathlib import Path
 from typing import TypeVar
 
 from archmetrics.app.collect import parse_all, select, worker_limits
-from archmetrics.app.coupling import configuration_files, coupling_options, rule_set
+from archmetrics.app.coupling import (
+    configuration_files,
+    coupling_options,
+    packs_digest,
+    rule_set,
+)
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.tree import Side, begin_delta, side_of
 from archmetrics.app.workers import WorkerLimits
@@ -134,7 +139,9 @@ def site_memo(
     matches rules and traces endpoints only for the files whose reach changed. ``measured``:
     the measured files, or rows by path (each file's content then named when asked for:
     a patch asks for the few files it redoes)."""
-    context = _digest([RECORD, code_fingerprint(), cache.fingerprint, repr(options), repr(packs)])
+    context = _digest(
+        [RECORD, code_fingerprint(), cache.fingerprint, repr(options), packs_digest(packs)]
+    )
     identity: Mapping[str, str]
     if isinstance(measured, Mapping):
         identity = _Contents(measured)

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from archmetrics.app.collect import Selected, parse_all, select
-from archmetrics.app.coupling import configuration_files
+from archmetrics.app.coupling import configuration_files, packs_digest
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.files import exclusion, measured_files
 from archmetrics.changeset.rows import FileRow
@@ -123,7 +123,7 @@ def state_key(tree: str, options: DiffOptions, cache: FactsCache) -> str:
     document = [
         STATE_RECORD, code_fingerprint(), cache.fingerprint, options.languages,
         repr(options.rules), options.limits.skip_generated, repr(options.coupling),
-        repr(options.packs), tree,
+        packs_digest(options.packs), tree,
     ]  # fmt: skip
     return f"{STATE_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
 

@@ -8,9 +8,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from archmetrics.cli import main
-from archmetrics.reports.json_report import _indented, dumps
+from archmetrics.reports.json_report import _SHORT_EXPONENT, _indented, _short_exponent, dumps
 from tests.gitrepo import GitRepo
 
 
@@ -53,3 +55,8 @@ def test_a_real_diff_report_is_written_as_json_would(
     assert main([*argv, "-o", str(out)]) == 0
     written = out.read_text(encoding="utf-8")
     assert written == _reference(json.loads(written))
+
+
+@given(st.text(alphabet="0123456789e-.x ", max_size=40))
+def test_the_short_exponent_check_finds_what_its_pattern_finds(text: str) -> None:
+    assert _short_exponent(text) == bool(_SHORT_EXPONENT.search(text))
