@@ -111,13 +111,22 @@ def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
     return RulePack(name, source, top.text(pack, "description", ""), rules, configuration)
 
 
-def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
+def rule_header(
+    raw: object, source: str, unnamed: str, keys: frozenset[str]
+) -> tuple[Where, Mapping[str, object], str]:
+    """A rule's table read with these ``keys``, the place errors name (the rule's id, or
+    ``unnamed`` when it has none) and its id, checked."""
     rule_id = raw.get("id") if isinstance(raw, Mapping) else None
-    where = Where(source, rule_id if isinstance(rule_id, str) else f"#{index + 1}")
-    table = where.table(raw, "", _RULE_KEYS)
+    where = Where(source, rule_id if isinstance(rule_id, str) else unnamed)
+    table = where.table(raw, "", keys)
     ident = where.text(table, "id")
     if not _ID.match(ident):
         where.fail("id", f"{ident!r} must be letters, digits and _.+-")
+    return where, table, ident
+
+
+def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
+    where, table, ident = rule_header(raw, source, f"#{index + 1}", _RULE_KEYS)
     languages = where.texts(table, "language", required=True)
     for language in languages:
         if language not in KNOWN_LANGUAGES:

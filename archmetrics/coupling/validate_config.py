@@ -15,7 +15,7 @@ from archmetrics.coupling.rules import (
     Role,
     RulePackError,
 )
-from archmetrics.coupling.validate import Where
+from archmetrics.coupling.validate import Where, rule_header
 from archmetrics.facts import ConfigFormat
 
 _KEYS = frozenset(
@@ -24,7 +24,6 @@ _KEYS = frozenset(
 )  # fmt: skip
 _ENDPOINT_KEYS = frozenset({"type", "key", "pattern"})
 _FORMATS = frozenset(str(f) for f in ConfigFormat)
-_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 _TABLE = re.compile(r"^[A-Za-z0-9_-]+(?:\.[A-Za-z0-9_-]+)*$")
 
 
@@ -36,12 +35,7 @@ def parse_configuration(raw: object, pack: str, source: str) -> tuple[ConfigRule
 
 
 def _rule(raw: object, pack: str, source: str, index: int) -> ConfigRule:
-    rule_id = raw.get("id") if isinstance(raw, Mapping) else None
-    where = Where(source, rule_id if isinstance(rule_id, str) else f"configuration #{index + 1}")
-    table = where.table(raw, "", _KEYS)
-    ident = where.text(table, "id")
-    if not _ID.match(ident):
-        where.fail("id", f"{ident!r} must be letters, digits and _.+-")
+    where, table, ident = rule_header(raw, source, f"configuration #{index + 1}", _KEYS)
     files = where.texts(table, "files", required=True)
     for glob in files:
         if glob.startswith("!") or not glob.strip("/"):

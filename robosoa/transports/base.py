@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from robosoa.errors import PublishTimeout, RobosoaError
 from robosoa.location import ServiceInfo
-from robosoa.message import Frames, Message
+from robosoa.message import Frames, Message, decode_frames
 from robosoa.stats import StatsBook
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
@@ -37,6 +37,22 @@ def offer_until(sink: Sink, offer: tuple[Message, int, float], deadline: float,
             raise PublishTimeout(channel[2:], max(0.0, deadline - start))
         time.sleep(pause)
         pause = min(pause * 2, 0.01)
+
+
+def hand_out(sinks: Sequence[Sink], frames: list[bytes], expires: float, block: float | None,
+             channel: str, options: BusOptions) -> None:  # fmt: skip
+    """A message published on this bus, to its own subscriptions (``sinks``), on the
+    publisher's thread: best-effort ones take it or drop it, reliable ones (``block`` given)
+    are offered it until they take it or ``block`` seconds have passed (PublishTimeout)."""
+    msg = decode_frames(frames, options.max_message, options.max_depth)
+    size = sum(map(len, frames))
+    if block is None:
+        for sink in sinks:
+            sink(msg, size, expires, False)
+        return
+    deadline = time.monotonic() + block
+    for sink in sinks:
+        offer_until(sink, (msg, size, expires), deadline, channel)
 
 
 class Unreachable(RobosoaError):

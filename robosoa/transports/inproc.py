@@ -23,7 +23,7 @@ from robosoa.transports.base import (
     ProtocolAdapter,
     Sink,
     Unreachable,
-    offer_until,
+    hand_out,
 )
 
 DEFAULT_NAME = "default"
@@ -196,15 +196,7 @@ class InprocAdapter(ProtocolAdapter):
         with broker.lock:
             sinks = list(broker.channels.get(channel, ()))
         if sinks:
-            delivered = decode_frames(frames, self.options.max_message, self.options.max_depth)
-            size = sum(map(len, frames))
-            if block is None:
-                for sink in sinks:
-                    sink(delivered, size, expires, False)
-                return
-            deadline = time.monotonic() + block
-            for sink in sinks:
-                offer_until(sink, (delivered, size, expires), deadline, channel)
+            hand_out(sinks, frames, expires, block, channel, self.options)
 
     def subscribe(self, channel: str, sink: Sink) -> Callable[[], None]:
         broker = self._live()

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections import deque
 from collections.abc import Callable
 
@@ -27,7 +26,7 @@ import zmq
 from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
 from robosoa.message import Message, decode_frames
-from robosoa.transports.base import BusOptions, Sink, offer_until
+from robosoa.transports.base import BusOptions, Sink, hand_out
 from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import MARK, META, prefix
 from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
@@ -145,15 +144,7 @@ class Feed:
         one waits for room up to ``block`` seconds (PublishTimeout)."""
         sinks = self._sinks.get(prefix(channel)[:-1])
         if sinks:
-            msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
-            size = sum(map(len, frames))
-            if block is None:
-                for sink in sinks:
-                    sink(msg, size, expires, False)
-                return
-            deadline = time.monotonic() + block
-            for sink in sinks:
-                offer_until(sink, (msg, size, expires), deadline, channel)
+            hand_out(sinks, frames, expires, block, channel, self._options)
 
     def _deliver(self, frames: list[bytes], hold: bool) -> bool:
         """Hand one message to its sinks; False if a reliable one refused it (held back:
