@@ -624,13 +624,21 @@ class _Owners:
             return self.slots[index]
         return None
 
-    def claim(self, offset: int) -> str | None:
-        """The enclosing function's name; counts one more statement in it."""
-        slot = self.at(offset)
-        if slot is None:
-            return None
-        slot.statements += 1
-        return slot.qualified
+    def claim(self, offsets: list[int]) -> list[str | None]:
+        """The enclosing function's name at each offset; counts one more statement in each."""
+        slots, starts = self.slots, self._starts
+        if not slots:
+            return [None] * len(offsets)
+        names: list[str | None] = []
+        for offset in offsets:
+            index = bisect.bisect_right(starts, offset) - 1
+            if index >= 0 and offset < slots[index].end:
+                slot = slots[index]
+                slot.statements += 1
+                names.append(slot.qualified)
+            else:
+                names.append(None)
+        return names
 
     def name(self, offset: int) -> str | None:
         slot = self.at(offset)
