@@ -546,8 +546,8 @@ def _facts(
         nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
     )
     _decisions(found, owner, reading.directive_decisions)
-    call_sites = CallSites(found.get("call", []), data).sites(owner.name)
-    bound = bindings(found.get("bind", []), clean, owner.name)
+    call_sites = CallSites(found.get("call", []), data).sites(owner.names)
+    bound = bindings(found.get("bind", []), clean, owner.names)
     return FileFacts(
         path=path,
         language=str(language),
@@ -640,9 +640,18 @@ class _Owners:
                 names.append(None)
         return names
 
-    def name(self, offset: int) -> str | None:
-        slot = self.at(offset)
-        return slot.qualified if slot is not None else None
+    def names(self, offsets: list[int]) -> list[str | None]:
+        """The enclosing function's name at each offset."""
+        slots, starts = self.slots, self._starts
+        if not slots:
+            return [None] * len(offsets)
+        names: list[str | None] = []
+        for offset in offsets:
+            index = bisect.bisect_right(starts, offset) - 1
+            names.append(
+                slots[index].qualified if index >= 0 and offset < slots[index].end else None
+            )
+        return names
 
 
 def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> list[FunctionSlot]:

@@ -43,6 +43,8 @@ def in_order(nodes: Iterable[Node]) -> list[Node]:
     starts = [node.start_byte for node in nodes]
     if len(set(starts)) < len(starts):  # two start together: the full key (rare, dearer)
         return sorted(nodes, key=lambda n: (n.start_byte, -n.end_byte, n.type))
+    if sorted(starts) == starts:  # the query's captures come in order: nothing to move
+        return nodes
     order = sorted(range(len(nodes)), key=starts.__getitem__)
     return [nodes[index] for index in order]
 
