@@ -100,10 +100,25 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
 
 _UNPRINTABLE = re.compile(r"[\x7f-\x9f\u2028\u2029\ud800-\udfff]")
 
+_DIGITS = frozenset("0123456789")
 
-# Where orjson's float spelling differs from json's: a one-digit negative exponent (1e-7 is
-# json's 1e-07); json switches to exponents only from 1e16 up, which both spell alike.
-_SHORT_EXPONENT = re.compile(r"[0-9]e-[0-9](?![0-9])")
+
+def short_exponent(text: str) -> bool:
+    """Whether ``text`` holds a digit, ``e-``, and one digit alone (``[0-9]e-[0-9](?![0-9])``):
+    where orjson's float spelling differs from json's, a one-digit negative exponent (1e-7 is
+    json's 1e-07); json switches to exponents only from 1e16 up, which both spell alike.
+    Found by looking at each ``e-`` (``str.find``): a regular expression starting with a
+    character class tried every character of a scan's 6 MB of JSON (0.03 s)."""
+    at = text.find("e-", 1)
+    while at >= 0:
+        if (
+            text[at - 1] in _DIGITS
+            and text[at + 2 : at + 3] in _DIGITS
+            and text[at + 3 : at + 4] not in _DIGITS
+        ):
+            return True
+        at = text.find("e-", at + 1)
+    return False
 
 
 def _indented(document: dict[str, Any]) -> str:
@@ -118,7 +133,7 @@ def _indented(document: dict[str, Any]) -> str:
     except TypeError:  # orjson.JSONEncodeError
         return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
     written = text.decode()
-    if _SHORT_EXPONENT.search(written):
+    if short_exponent(written):
         return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
     return written
 
@@ -128,6 +143,8 @@ def dumps(document: dict[str, Any]) -> str:
     separators and lone surrogates are escaped here too (``\\u0085``), so the text is valid
     UTF-8 and safe to print (docs/security.md)."""
     text = _indented(document)
+    if text.isascii() and "\x7f" not in text:  # nothing to escape (both checks in C, fast)
+        return text
     return _UNPRINTABLE.sub(lambda found: f"\\u{ord(found.group()):04x}", text)
 
 
