@@ -218,11 +218,18 @@ def statements(
         texts[index] = own
     for index, prefix in prefixes.items():
         texts[index] = prefix + texts[index]
-    # rows are valid spans (first >= 0, last >= first): built without Span's check
+    return _records(kinds, rows, texts, owners(starts))
+
+
+def _records(
+    kinds: list[str], rows: list[tuple[int, int]], texts: list[str], functions: list[str | None]
+) -> list[Statement]:
+    """The statements, built by ``tuple.__new__``: each row is a valid span (first >= 1,
+    last >= first), so Span's check is not run again."""
     new = tuple.__new__
     return [
         new(Statement, (kind, new(Span, row), text, function))
-        for kind, row, text, function in zip(kinds, rows, texts, owners(starts), strict=True)
+        for kind, row, text, function in zip(kinds, rows, texts, functions, strict=True)
     ]
 
 
