@@ -269,8 +269,7 @@ def parse_in_workers(
         while run.pending or any(w.batch for w in crew):
             for worker in crew:
                 if not worker.batch and run.pending:
-                    batch = run.pending.popleft()
-                    worker.give(batch, run.make_tasks(batch))
+                    _give_next(worker, run)
             for index, worker in enumerate(crew):
                 if _watch(worker, run) is False:
                     worker.stop()
@@ -304,6 +303,11 @@ def _wait(crew: list[_Worker[Any]], limits: WorkerLimits) -> None:
     multiprocessing.connection.wait(handles, timeout=min(1.0, max(0.05, limits.file_seconds / 4)))
 
 
+def _give_next(worker: _Worker[T], run: _Run[T]) -> None:
+    batch = run.pending.popleft()
+    worker.give(batch, run.make_tasks(batch))
+
+
 def _watch(worker: _Worker[T], run: _Run[T]) -> bool | None:
     """Take what ``worker`` has for us. False: it is dead (or was killed) and must be replaced."""
     if not worker.batch:
@@ -314,6 +318,8 @@ def _watch(worker: _Worker[T], run: _Run[T]) -> bool | None:
         except (EOFError, OSError):
             return _lost(worker, run, _death(worker))
         batch, worker.batch = worker.batch, []
+        if run.pending:  # its next batch first: it parses while these answers are delivered
+            _give_next(worker, run)
         for item, answer in zip(batch, answers, strict=True):
             run.deliver(item, answer)
         return True

@@ -546,8 +546,8 @@ def _facts(
         nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
     )
     _decisions(found, owner, reading.directive_decisions)
-    call_sites = CallSites(found.get("call", []), data).sites(owner.name)
-    bound = bindings(found.get("bind", []), clean, owner.name)
+    call_sites = CallSites(found.get("call", []), data).sites(owner.names)
+    bound = bindings(found.get("bind", []), clean, owner.names)
     return FileFacts(
         path=path,
         language=str(language),
@@ -624,17 +624,34 @@ class _Owners:
             return self.slots[index]
         return None
 
-    def claim(self, offset: int) -> str | None:
-        """The enclosing function's name; counts one more statement in it."""
-        slot = self.at(offset)
-        if slot is None:
-            return None
-        slot.statements += 1
-        return slot.qualified
+    def claim(self, offsets: list[int]) -> list[str | None]:
+        """The enclosing function's name at each offset; counts one more statement in each."""
+        slots, starts = self.slots, self._starts
+        if not slots:
+            return [None] * len(offsets)
+        names: list[str | None] = []
+        for offset in offsets:
+            index = bisect.bisect_right(starts, offset) - 1
+            if index >= 0 and offset < slots[index].end:
+                slot = slots[index]
+                slot.statements += 1
+                names.append(slot.qualified)
+            else:
+                names.append(None)
+        return names
 
-    def name(self, offset: int) -> str | None:
-        slot = self.at(offset)
-        return slot.qualified if slot is not None else None
+    def names(self, offsets: list[int]) -> list[str | None]:
+        """The enclosing function's name at each offset."""
+        slots, starts = self.slots, self._starts
+        if not slots:
+            return [None] * len(offsets)
+        names: list[str | None] = []
+        for offset in offsets:
+            index = bisect.bisect_right(starts, offset) - 1
+            names.append(
+                slots[index].qualified if index >= 0 and offset < slots[index].end else None
+            )
+        return names
 
 
 def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> list[FunctionSlot]:

@@ -60,27 +60,29 @@ def _parts(node: Node) -> tuple[Node | None, Node | None]:
 
 
 def bindings(
-    captured: list[Node], clean: bytes, owner: Callable[[int], str | None]
+    captured: list[Node], clean: bytes, owners: Callable[[list[int]], list[str | None]]
 ) -> tuple[Binding, ...]:
     """The bindings of the captured nodes in source order; ``clean``: the file with comments
-    blanked; ``owner``: the enclosing function's qualified name at a byte offset."""
-    found: list[tuple[str, int, str | None]] = []
+    blanked; ``owners``: the enclosing function's qualified name at each byte offset."""
+    found: list[tuple[str, int]] = []
+    starts: list[int] = []
     values: list[bytes] = []
     for node in in_order(captured):
         name, value = _parts(node)
         if name is None or value is None:
             continue
-        found.append(
-            (
-                compact(clean[name.start_byte : name.end_byte]),
-                node.start_point.row + 1,
-                owner(node.start_byte),
-            )
-        )
+        written = clean[name.start_byte : name.end_byte]
+        # an identifier is one token: its compact form is its bytes
+        text = written.decode("utf-8", "replace") if name.type in _NAMES else compact(written)
+        found.append((text, node.start_point.row + 1))
+        starts.append(node.start_byte)
         values.append(clean[value.start_byte : value.end_byte])
     texts = normal_many(values)
+    new = tuple.__new__
     return tuple(
-        Binding(name, text, line, function)
-        for (name, line, function), text in zip(found, texts, strict=True)
-        if text
+        [
+            new(Binding, (name, text, line, function))
+            for (name, line), text, function in zip(found, texts, owners(starts), strict=True)
+            if text
+        ]
     )

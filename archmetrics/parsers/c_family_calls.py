@@ -12,15 +12,16 @@ from collections.abc import Callable
 
 from tree_sitter import Node
 
-from archmetrics.facts import Argument, CallSite, Literal
+from archmetrics.facts import Argument, CallSite, Literal, Span
 from archmetrics.parsers import shown
-from archmetrics.parsers.c_family_names import in_order, span, text
+from archmetrics.parsers.c_family_names import in_order, text
 from archmetrics.parsers.c_family_text import compact, literal, normal, string_value
 from archmetrics.parsers.text import collapse
 
 _STRINGS = frozenset({"string_literal", "raw_string_literal"})
 _CALLEE = re.compile(r"(.*)(\.|->|::)(~?[A-Za-z_$][\w$]*)\Z", re.DOTALL)
 _SPACE_OR_COMMENT = re.compile(rb"\s|/[/*]")
+_new = tuple.__new__
 
 
 def without_template_arguments(written: str) -> str:
@@ -56,14 +57,23 @@ class CallSites:
     def __init__(self, nodes: list[Node], data: bytes) -> None:
         self._nodes = in_order(nodes)
         self._data = data
-        self._opens: list[int] | None = None  # where each long call's argument list starts
+        # where each long call's argument list starts (none in most files: then no text
+        # is checked for one)
+        lists = (
+            node.child_by_field_name("arguments")
+            for node in self._nodes
+            if node.end_byte - node.start_byte > shown.LIMIT
+        )
+        self._opens = sorted(node.start_byte for node in lists if node is not None)
         # cut texts by where they start and how they are read, with the end of the bytes
         # read for them: the calls of a chain share one
         self._cut: dict[tuple[int, Callable[[bytes], str]], tuple[int, str]] = {}
 
-    def sites(self, owner: Callable[[int], str | None]) -> tuple[CallSite, ...]:
-        """Every call site in order; ``owner`` names the function around an offset."""
-        return tuple(self._site(node, owner(node.start_byte)) for node in self._nodes)
+    def sites(self, owners: Callable[[list[int]], list[str | None]]) -> tuple[CallSite, ...]:
+        """Every call site in order; ``owners`` names the function around each offset."""
+        nodes = self._nodes
+        functions = owners([node.start_byte for node in nodes])
+        return tuple(map(self._site, nodes, functions))
 
     def _site(self, node: Node, function: str | None) -> CallSite:
         function_node = node.child_by_field_name("function")
@@ -83,11 +93,18 @@ class CallSites:
         values: tuple[Argument, ...] = ()
         if arguments is not None:
             values = tuple(
-                self._argument(child)
-                for child in arguments.named_children
-                if child.type != "comment"
+                [
+                    self._argument(child)
+                    for child in arguments.named_children
+                    if child.type != "comment"
+                ]
             )
-        return CallSite(called, name, receiver or None, span(node), values, function)
+        # the node's lines, as ``span`` gives them (a valid span: built without its check)
+        first = node.start_point.row + 1
+        end_point = node.end_point
+        last = end_point.row + 1 if end_point.column else max(end_point.row, first)
+        where = _new(Span, (first, last))
+        return _new(CallSite, (called, name, receiver or None, where, values, function))
 
     def _callee(self, node: Node | None) -> str:
         """The called expression's text, template arguments dropped: `Ice::checkedCast`."""
@@ -102,12 +119,12 @@ class CallSites:
 
     def _argument(self, node: Node) -> Argument:
         start, end = node.start_byte, node.end_byte
-        if self._holds_call(start, end):
+        if self._opens and self._holds_call(start, end):
             return Argument(self._text(start, end, _argument_text))  # no literal holds a call
         raw = self._data[start:end]
         kind = node.type
         if kind == "identifier":
-            return Argument(raw.decode("utf-8", "replace"))
+            return _new(Argument, (raw.decode("utf-8", "replace"), None, False, None))
         written = _argument_text(raw)  # (no long call inside: not cut)
         value: Literal = None
         is_literal = False
@@ -124,12 +141,12 @@ class CallSites:
                 value = -number if isinstance(number, int | float) else None
         else:
             is_literal, value = literal(kind, raw)
-        return Argument(written, value, is_literal)
+        return _new(Argument, (written, value, is_literal, None))
 
     def _text(self, start: int, end: int, read: Callable[[bytes], str]) -> str:
         """``read`` of bytes ``start:end``; cut if it holds a long call, and then read by
         growing windows from its start, not whole."""
-        if not self._holds_call(start, end):
+        if not self._opens or not self._holds_call(start, end):
             return read(self._data[start:end])
         found = self._cut.get((start, read))
         if found is not None and found[0] <= end:
@@ -151,13 +168,6 @@ class CallSites:
         """True when bytes ``start:end`` hold a call longer than ``shown.LIMIT`` bytes: its
         argument list opens among them (a call around the range opens its list outside)."""
         opens = self._opens
-        if opens is None:
-            lists = (
-                node.child_by_field_name("arguments")
-                for node in self._nodes
-                if node.end_byte - node.start_byte > shown.LIMIT
-            )
-            opens = self._opens = sorted(node.start_byte for node in lists if node is not None)
         index = bisect.bisect_left(opens, start)
         return index < len(opens) and opens[index] < end
 

@@ -21,7 +21,7 @@ _NOT_COUNTED_DIRECTIVES = frozenset({"#pragma once", "#"})
 _GUARD_CONDITION = re.compile(r"!defined\(?(\w+)\)?")
 
 # (start byte, end byte, first row, last row, prefix, kind)
-_Extent = tuple[int, int, int, int, bytes, str]
+_Extent = tuple[int, int, int, int, str, str]
 
 
 def _last_row(point: Point) -> int:
@@ -48,8 +48,8 @@ def _header(node: Node, rule: StatementRule) -> _Extent | None:
         return None
     last = _previous_token(node, body)
     if last is None:
-        return node.start_byte, body.start_byte, node.start_point.row, body.start_point.row, b"", ""
-    return node.start_byte, last.end_byte, node.start_point.row, _last_row(last.end_point), b"", ""
+        return node.start_byte, body.start_byte, node.start_point.row, body.start_point.row, "", ""
+    return node.start_byte, last.end_byte, node.start_point.row, _last_row(last.end_point), "", ""
 
 
 def _label(node: Node) -> _Extent | None:
@@ -61,7 +61,7 @@ def _label(node: Node) -> _Extent | None:
             break
         if child.type == ":":
             end = child.end_point.row
-            return node.start_byte, child.end_byte, node.start_point.row, end, b"", kind
+            return node.start_byte, child.end_byte, node.start_point.row, end, "", kind
     return None
 
 
@@ -71,7 +71,7 @@ def _do_while(node: Node) -> _Extent | None:
     if keyword is None or keyword.type != "while":
         return None
     last = _last_row(node.end_point)
-    return keyword.start_byte, node.end_byte, keyword.start_point.row, last, b"do ", ""
+    return keyword.start_byte, node.end_byte, keyword.start_point.row, last, "do ", ""
 
 
 def _extent(node: Node, rule: StatementRule) -> _Extent:
@@ -86,7 +86,7 @@ def _extent(node: Node, rule: StatementRule) -> _Extent:
     if shaped is not None:
         return shaped
     first = node.start_point.row
-    return node.start_byte, node.end_byte, first, max(first, _last_row(node.end_point)), b"", ""
+    return node.start_byte, node.end_byte, first, max(first, _last_row(node.end_point)), "", ""
 
 
 class Bodies:
@@ -94,14 +94,14 @@ class Bodies:
 
     def __init__(self, nodes: list[Node]) -> None:
         ranges = sorted((node.start_byte, node.end_byte) for node in nodes)
-        self._starts = [start for start, _ in ranges]
+        self.starts = [start for start, _ in ranges]
         self._ends = [end for _, end in ranges]
 
     def inside(self, start: int, end: int) -> list[tuple[int, int]]:
         """The outermost bodies lying wholly inside [start, end); those inside them are
         stepped over, not visited (a statement around n nested lambdas would visit n)."""
         cuts: list[tuple[int, int]] = []
-        starts = self._starts
+        starts = self.starts
         index = bisect.bisect_left(starts, start)
         while index < len(starts) and starts[index] < end:
             body_start, body_end = starts[index], self._ends[index]
@@ -146,7 +146,7 @@ def _bounds(node: Node, rule: StatementRule, templates: Mapping[int, tuple[int, 
     if rule.shape is Shape.WHOLE:  # the common case, kept cheap
         end_point = node.end_point
         last = end_point.row if end_point.column else end_point.row - 1
-        bounds = (node.start_byte, node.end_byte, node.start_point.row, last, b"", "")
+        bounds = (node.start_byte, node.end_byte, node.start_point.row, last, "", "")
     else:
         bounds = _extent(node, rule)
     if bounds[0] in templates:
@@ -161,36 +161,75 @@ def statements(
     bodies: Bodies,
     clean: bytes,
     templates: Mapping[int, tuple[int, int]],
-    owner: Callable[[int], str | None],
+    owners: Callable[[list[int]], list[str | None]],
 ) -> list[Statement]:
-    """One Statement per counted node; ``owner`` names (and counts in) the enclosing function.
+    """One Statement per counted node; ``owners`` names (and counts in) the enclosing
+    function of each statement's start byte, all at once.
 
-    ``clean`` is the file with comments blanked. Texts are normalized in one batch at the end.
-    """
-    heads: list[tuple[str, int, int, str, str | None]] = []
+    ``clean`` is the file with comments blanked. Texts are normalized in one batch at the
+    end. The loop is the parser's hottest: a node of the commonest shape (the whole node,
+    no body inside it) costs a few attribute reads and no call of ours."""
+    whole = {kind: rule.kind for kind, rule in rules.items() if rule.shape is Shape.WHOLE}
+    body_starts = bodies.starts
+    no_body = len(body_starts)
+    kinds: list[str] = []
+    rows: list[tuple[int, int]] = []
+    prefixes: dict[int, str] = {}
+    starts: list[int] = []
     pieces: list[bytes] = []
     fixed: dict[int, str] = {}
     for node in nodes:
         kind = node.type
         if kind == "expression_statement" and node.named_child_count == 0:
             continue  # the empty statement `;`
-        rule = rules[kind]
-        start, end, first, last, prefix, override = _bounds(node, rule, templates)
+        kind_name = whole.get(kind)
+        if kind_name is not None:
+            start, end = node.start_byte, node.end_byte
+            first = node.start_point.row
+            end_point = node.end_point
+            last = end_point.row if end_point.column else end_point.row - 1
+            if start in templates:
+                start, first = templates[start]
+            prefix = ""
+        else:
+            rule = rules[kind]
+            start, end, first, last, prefix, override = _bounds(node, rule, templates)
+            kind_name = override or rule.kind
         if kind[0] == "p":  # preproc_*: normalized one by one, some do not count
             own = _fixed_text(node, start, end, clean)
             if own in _NOT_COUNTED_DIRECTIVES:
                 continue
             if own is not None:
                 fixed[len(pieces)] = own
-        pieces.append(b"" if len(pieces) in fixed else _piece(start, end, clean, bodies))
-        kind_name = override or rule.kind
-        heads.append((kind_name, first, max(first, last), prefix.decode(), owner(node.start_byte)))
+                pieces.append(b"")
+        if len(pieces) == len(kinds):  # not fixed: its own bytes, nested bodies cut
+            index = bisect.bisect_left(body_starts, start)
+            if index == no_body or body_starts[index] >= end:
+                pieces.append(clean[start:end])
+            else:
+                pieces.append(_piece(start, end, clean, bodies))
+        if prefix:
+            prefixes[len(kinds)] = prefix
+        kinds.append(kind_name)
+        rows.append((first + 1, (first if first > last else last) + 1))
+        starts.append(node.start_byte)
     texts = normal_many(pieces)
     for index, own in fixed.items():
         texts[index] = own
+    for index, prefix in prefixes.items():
+        texts[index] = prefix + texts[index]
+    return _records(kinds, rows, texts, owners(starts))
+
+
+def _records(
+    kinds: list[str], rows: list[tuple[int, int]], texts: list[str], functions: list[str | None]
+) -> list[Statement]:
+    """The statements, built by ``tuple.__new__``: each row is a valid span (first >= 1,
+    last >= first), so Span's check is not run again."""
+    new = tuple.__new__
     return [
-        Statement(kind, Span(first + 1, last + 1), prefix + texts[index], function)
-        for index, (kind, first, last, prefix, function) in enumerate(heads)
+        new(Statement, (kind, new(Span, row), text, function))
+        for kind, row, text, function in zip(kinds, rows, texts, functions, strict=True)
     ]
 
 

@@ -219,7 +219,19 @@ _BATCH_TOKEN = re.compile(
 
 
 def normal_many(pieces: list[bytes]) -> list[str]:
-    """``normal`` of each piece (comments already blanked), in one regex pass for all of them."""
+    """``normal`` of each piece (comments already blanked), in one regex pass for all of
+    them. A file repeats many of its statements (``break;``, ``return 0;``, ``i++;``: on
+    numpy's C/C++, 45% of the pieces of a file are another's copy): each distinct piece is
+    read once."""
+    distinct = list(dict.fromkeys(pieces))
+    if len(distinct) == len(pieces):
+        return _normal_each(pieces)
+    texts = dict(zip(distinct, _normal_each(distinct), strict=True))
+    return [texts[piece] for piece in pieces]
+
+
+def _normal_each(pieces: list[bytes]) -> list[str]:
+    """``normal`` of each piece, in one regex pass for all of them."""
     special = [index for index, piece in enumerate(pieces) if b'R"' in piece]
     batch = list(pieces)
     for index in special:

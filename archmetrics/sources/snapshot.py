@@ -7,7 +7,7 @@ import os
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from archmetrics.globs import gitignore_file
 from archmetrics.sources.paths import quote_path
@@ -72,6 +72,13 @@ def blob_hash(data: bytes) -> str:
     digest = hashlib.sha1(b"blob %d\0" % len(data), usedforsecurity=False)
     digest.update(data)
     return digest.hexdigest()
+
+
+@runtime_checkable
+class Sized(Protocol):
+    """A snapshot that can tell a file's size without reading it (the files on disk)."""
+
+    def size(self, file: SourceFile) -> int | None: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,6 +148,14 @@ class DirectorySnapshot:
             return (self.root / self._on_disk.get(file.path, file.path)).read_bytes()
         except OSError as error:
             raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
+
+    def size(self, file: SourceFile) -> int | None:
+        """The file's size on disk, None if it cannot be asked (it is read later, and a
+        problem is reported then)."""
+        try:
+            return os.stat(self.root / self._on_disk.get(file.path, file.path)).st_size
+        except OSError:
+            return None
 
 
 def _walk_folder(root: Path, folder: Path, skipped: dict[str, str]) -> Iterator[str]:

@@ -15,7 +15,7 @@ from archmetrics.cli import main
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources import WORKTREE, codec, open_snapshot
 from archmetrics.sources.cache import FactsCache
-from archmetrics.sources.snapshot import DirectorySnapshot, blob_hash
+from archmetrics.sources.snapshot import DirectorySnapshot, SourceFile, blob_hash
 from tests.gitrepo import GitRepo
 from tests.harness import facts_of
 
@@ -170,3 +170,46 @@ def test_a_worktree_file_whose_bytes_differ_from_its_blob_is_kept_under_its_byte
         assert blobs == {"m.py": blob_hash(on_disk)}
         assert cache.get(blob_hash(on_disk), "python", "m.py") is not None
         assert cache.get(blob_hash(b"x = 1\n"), "python", "m.py") is None
+
+
+class _Recording(DirectorySnapshot):
+    """Files on disk whose blobs are known (as a work tree's staged files are), so that each
+    is read only when its batch goes to a worker: the reads are the order of parsing."""
+
+    def __init__(self, root: Path, paths: list[str]) -> None:
+        super().__init__(root, paths)
+        self._hashes = {path: blob_hash((root / path).read_bytes()) for path in paths}
+        self.reads: list[str] = []
+
+    def read(self, file: SourceFile) -> bytes:
+        self.reads.append(file.path)
+        return super().read(file)
+
+
+class _Unsized:
+    """The same files where no size can be known without reading (a revision's blobs)."""
+
+    def __init__(self, inner: _Recording) -> None:
+        self.inner, self.label = inner, inner.label
+
+    def files(self) -> tuple[SourceFile, ...]:
+        return self.inner.files()
+
+    def read(self, file: SourceFile) -> bytes:
+        return self.inner.read(file)
+
+
+def test_the_largest_files_are_parsed_first_where_sizes_are_known(tmp_path: Path) -> None:
+    """The last batches hold the smallest files, so no worker is left with a large one when
+    the others are done; files of unknown size keep their order."""
+    functions = {"a.c": 1, "b.c": 40, "c.c": 8, "d.c": 20}
+    for name, count in functions.items():
+        (tmp_path / name).write_text("".join(C.format(i=i) for i in range(count)))
+    snapshot = _Recording(tmp_path, list(functions))
+    selected = select(snapshot, LanguageTable.default())
+    facts = parse_all(snapshot, selected, jobs=1)
+    assert snapshot.reads == ["b.c", "d.c", "c.c", "a.c"]
+    assert [f.path for f in facts] == ["a.c", "b.c", "c.c", "d.c"]  # reported as listed
+    unsized = _Unsized(_Recording(tmp_path, list(functions)))
+    parse_all(unsized, select(unsized, LanguageTable.default()), jobs=1)
+    assert unsized.inner.reads == ["a.c", "b.c", "c.c", "d.c"]

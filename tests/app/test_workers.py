@@ -292,3 +292,20 @@ def test_a_worker_that_answers_gets_its_next_batch_while_another_is_busy(
     parse_in_workers(batches, tasks, deliver, workers=2)
     assert answered[-1] == "slow"
     assert sorted(answered[:-1]) == sorted(f"fast{i}" for i in range(12))
+
+
+def test_a_worker_gets_its_next_batch_before_its_answers_are_delivered() -> None:
+    """The parent's delivery of a batch's answers (decoding facts, caching them) must not
+    keep the worker that gave them idle: its next batch is sent first."""
+    events: list[str] = []
+
+    def tasks(batch: list[str]) -> list[tuple[str, bytes, str]]:
+        events.append(f"send {batch[0]}")
+        return [(name, b"x = 1\n", "python") for name in batch]
+
+    def deliver(name: str, answer: Parsed) -> None:
+        assert answer.encoded is not None, answer.failure
+        events.append(f"deliver {name}")
+
+    parse_in_workers([["a"], ["b"], ["c"]], tasks, deliver, workers=1)
+    assert events == ["send a", "send b", "deliver a", "send c", "deliver b", "deliver c"]
