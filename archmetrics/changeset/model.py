@@ -124,17 +124,19 @@ class ElementChange(NamedTuple):
     file_changes: tuple[FileChange, ...] = ()  # the detail behind added/removed/modified
 
     def to_dict(self) -> dict[str, JsonValue]:
-        pre, post = self.pre, self.post
+        # a diff writes one per element of the tree (28,000 in a large one): the fields by
+        # unpacking, the enums' values as stored (``_value_``: ``.value`` is a property)
+        element, location, files, status, pre, post, added, removed, modified, _ = self
         return {
-            "element": self.element,
-            "location": self.location.value,
-            "files": list(self.files),
-            "status": self.status.value,
-            "pre": None if pre is None else dict(zip(_METRIC_FIELDS, pre, strict=True)),
-            "post": None if post is None else dict(zip(_METRIC_FIELDS, post, strict=True)),
-            "added": self.added,
-            "removed": self.removed,
-            "modified": self.modified,
+            "element": element,
+            "location": location._value_,
+            "files": list(files),
+            "status": status._value_,
+            "pre": None if pre is None else dict(zip(_METRIC_FIELDS, pre)),
+            "post": None if post is None else dict(zip(_METRIC_FIELDS, post)),
+            "added": added,
+            "removed": removed,
+            "modified": modified,
         }
 
 

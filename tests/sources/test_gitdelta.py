@@ -11,8 +11,11 @@ import os
 import subprocess
 from pathlib import Path
 
+from hypothesis import given
+from hypothesis import strategies as st
+
 from archmetrics.sources import INDEX, WORKTREE, open_snapshot
-from archmetrics.sources.gitdelta import Delta
+from archmetrics.sources.gitdelta import Delta, _flagged
 from archmetrics.sources.snapshot import blob_hash
 from tests.gitrepo import GitRepo
 
@@ -134,3 +137,13 @@ def test_a_pending_delta_cancelled_leaves_no_process(repo: GitRepo, tmp_path: Pa
     pending = open_snapshot(repo.root, WORKTREE).delta_from(commit)  # type: ignore[attr-defined]
     pending.cancel()
     assert all(p.returncode is not None for p in pending.processes)
+
+
+@given(st.lists(st.tuples(st.sampled_from(["H", "h", "S", "M", "C", "K", "?"]),
+                          st.text(alphabet="aH \n/é", min_size=1, max_size=6))))  # fmt: skip
+def test_an_entry_tagged_other_than_h_is_found_in_any_listing(
+    entries: list[tuple[str, str]],
+) -> None:
+    """``ls-files -z -v`` listings, paths with spaces, newlines and ``H`` in them."""
+    listing = b"".join(f"{tag} {path}\0".encode() for tag, path in entries)
+    assert _flagged(listing) == any(tag != "H" for tag, _ in entries)
