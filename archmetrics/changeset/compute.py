@@ -118,7 +118,8 @@ def compute_change(
         else:
             change = element_change(name, groups[name], rules, sides, element_notes, diff)
         changes.append(change)
-        notes += [(change.location, n) for n in element_notes]
+        if element_notes:
+            notes += [(change.location, n) for n in element_notes]
     if unchanged and unchanged.excluded:
         excluded = sorted([*excluded, *unchanged.excluded], key=lambda x: (x.path, x.reason))
     return report_of(changes, excluded, side_notes(sides), notes)

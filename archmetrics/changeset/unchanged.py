@@ -84,7 +84,8 @@ def unchanged_change(
     """The change set of an element none of whose files changed: empty, its metrics the
     same on both sides but for coupling (notes in the order ``element_change`` gives them).
     Made for most elements of a large tree: the tuples are built directly (``_new``)."""
-    pre, post = (_metrics(name, row, side, notes) for side in sides)
+    pre = _metrics(name, row, sides[0], notes)
+    post = _metrics(name, row, sides[1], notes)
     if row.notes:
         notes.extend(row.notes)
     return _new(ElementChange, (name, row[1], row[0], _UNCHANGED, pre, post, 0, 0, 0, ()))

@@ -138,6 +138,9 @@ def _table_columns(state: TreeState, at: Mapping[str, int]) -> list[Any]:
     return [codes, numbers, flat, sizes, partial]
 
 
+_new = tuple.__new__  # a named tuple from its fields, without its class's Python-level __new__
+
+
 def _loads(text: bytes) -> Any:
     import orjson
 
@@ -240,10 +243,9 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
             ParseWarning(files[i], line, message, Severity(_SEVERITIES[severity]))
         )
     flags = numbers[3::5]
-    made = map(
-        FileRow,
+    fields = zip(
         files,
-        [languages[c] for c in numbers[4::5]],
+        list(map(languages.__getitem__, numbers[4::5])),
         blobs,
         numbers[0::5],
         numbers[1::5],
@@ -252,8 +254,7 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
         [bool(f & _GENERATED) for f in flags],
         [tuple(warnings.get(i, ())) for i in range(count)] if warnings else repeat(()),
     )
-    rows = list(made)
-    return tuple(rows)
+    return tuple(map(_new, repeat(FileRow), fields))  # rows checked above: made directly
 
 
 def _regrouped(
@@ -386,8 +387,7 @@ def _table(value: object, groups: Sequence[Element], files: list[str]) -> dict[s
         members[entry[0]] = chosen
     named = [element.name for element in groups]
     own = [members.get(k) or element.files for k, element in enumerate(groups)]
-    made = map(
-        ElementRow,
+    fields = zip(
         own,
         [_LOCATIONS[code] for code in locations],
         map(tuple, texts),
@@ -395,6 +395,7 @@ def _table(value: object, groups: Sequence[Element], files: list[str]) -> dict[s
         sums[1::3],
         sums[2::3],
     )
+    made = map(_new, repeat(ElementRow), fields)  # checked above: made directly
     return {name: row for name, row, code in zip(named, made, locations, strict=True) if code >= 0}
 
 
