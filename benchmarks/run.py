@@ -333,6 +333,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--work", type=Path, default=HERE / ".work")
     args = parser.parse_args(argv)
     try:
+        if "diff" in args.only:
+            report.ensure_cloc()  # installed before the machine line names its version
         machine = report.machine(Path(sys.executable).parent)
         rows, failures = run(args, lambda r, f: _save(args, machine, r, f))
     except BenchError as error:
