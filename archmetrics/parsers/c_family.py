@@ -626,32 +626,30 @@ class _Owners:
 
     def claim(self, offsets: list[int]) -> list[str | None]:
         """The enclosing function's name at each offset; counts one more statement in each."""
-        slots, starts = self.slots, self._starts
-        if not slots:
-            return [None] * len(offsets)
         names: list[str | None] = []
-        for offset in offsets:
-            index = bisect.bisect_right(starts, offset) - 1
-            if index >= 0 and offset < slots[index].end:
-                slot = slots[index]
+        for slot in self._slots_at(offsets):
+            if slot is None:
+                names.append(None)
+            else:
                 slot.statements += 1
                 names.append(slot.qualified)
-            else:
-                names.append(None)
         return names
 
     def names(self, offsets: list[int]) -> list[str | None]:
         """The enclosing function's name at each offset."""
+        return [None if slot is None else slot.qualified for slot in self._slots_at(offsets)]
+
+    def _slots_at(self, offsets: list[int]) -> list[FunctionSlot | None]:
+        """The function holding each offset (one bisection each: the file's statements are
+        claimed all at once)."""
         slots, starts = self.slots, self._starts
         if not slots:
             return [None] * len(offsets)
-        names: list[str | None] = []
+        found: list[FunctionSlot | None] = []
         for offset in offsets:
             index = bisect.bisect_right(starts, offset) - 1
-            names.append(
-                slots[index].qualified if index >= 0 and offset < slots[index].end else None
-            )
-        return names
+            found.append(slots[index] if index >= 0 and offset < slots[index].end else None)
+        return found
 
 
 def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> list[FunctionSlot]:
