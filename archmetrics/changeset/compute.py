@@ -47,7 +47,7 @@ from archmetrics.changeset.model import (
     Metrics,
 )
 from archmetrics.changeset.rows import diff_measured
-from archmetrics.changeset.unchanged import Unchanged, unchanged_change
+from archmetrics.changeset.unchanged import PlainElements, Unchanged, unchanged_change
 from archmetrics.coupling.elements import group_elements
 from archmetrics.coupling.model import CouplingReport
 
@@ -57,10 +57,16 @@ def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
     return {e.element.name: Coupling(e.s_a, e.s_e, e.d_a, e.d_e) for e in report.elements}
 
 
-def _sums(elements: Sequence[ElementChange]) -> Sums:
-    """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31)."""
+def _sums(
+    elements: Sequence[ElementChange], plain: tuple[Metrics, Metrics] | None = None
+) -> Sums:
+    """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31);
+    ``plain``: the sums of its unchanged elements kept as columns, before and after."""
     pre = [e.pre for e in elements if e.pre is not None]
     post = [e.post for e in elements if e.post is not None]
+    if plain is not None:
+        pre.append(plain[0])
+        post.append(plain[1])
     return Sums(
         Metrics(*map(sum, zip(*pre, strict=True))) if pre else Metrics(),
         Metrics(*map(sum, zip(*post, strict=True))) if post else Metrics(),
@@ -110,9 +116,18 @@ def compute_change(
     sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
     changes: list[ElementChange] = []
     notes: list[tuple[Location, str]] = []
+    plain: list[str] = []
+    before, after = coupling_pre, coupling_post
     for name in sorted(groups.keys() | rows.keys()):
-        element_notes: list[str] = []
         row = rows.get(name)
+        if row is not None and before is not None and after is not None:
+            found = after.get(name)
+            if found is not None and before.get(name) == found:  # kept as columns
+                plain.append(name)
+                if row.notes:
+                    notes += [(row.location, n) for n in row.notes]
+                continue
+        element_notes: list[str] = []
         if row is not None:
             change = unchanged_change(name, row, sides, element_notes)
         else:
@@ -122,7 +137,8 @@ def compute_change(
             notes += [(change.location, n) for n in element_notes]
     if unchanged and unchanged.excluded:
         excluded = sorted([*excluded, *unchanged.excluded], key=lambda x: (x.path, x.reason))
-    return report_of(changes, excluded, side_notes(sides), notes)
+    kept = PlainElements(tuple(plain), rows, after, dynamic_pre_zero) if plain else None
+    return report_of(changes, excluded, side_notes(sides), notes, kept)
 
 
 def report_of(
@@ -130,6 +146,7 @@ def report_of(
     excluded: Iterable[ExcludedFile] = (),
     common: Iterable[str] = (),
     notes: Iterable[tuple[Location, str]] = (),
+    plain: PlainElements | None = None,
 ) -> ChangeReport:
     """S(L) per location and S_tot from element change sets however they were found: by
     diffing files (:func:`compute_change`) or from an integration plan (changeset/plan.py).
@@ -143,10 +160,11 @@ def report_of(
     located: dict[Location, list[ElementChange]] = {loc: [] for loc in Location}
     for change in changes:
         located[change.location].append(change)
+    kept = plain.sums() if plain else {}
     summaries = tuple(
-        (loc, location_summary(_sums(located[loc]), (*common, *by_location[loc])))
+        (loc, location_summary(_sums(located[loc], kept.get(loc)), (*common, *by_location[loc])))
         for loc in Location
     )
     all_notes = [*common, *(n for loc in Location for n in by_location[loc])]
     total = total_summary((s for _, s in summaries), all_notes)
-    return ChangeReport(summaries, total, changes, tuple(excluded))
+    return ChangeReport(summaries, total, changes, tuple(excluded), plain)

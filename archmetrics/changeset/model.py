@@ -8,8 +8,11 @@ undefined -- always with a note saying why (docs/metrics.md, "Conventions").
 
 from __future__ import annotations
 
+import heapq
+from collections.abc import Iterator
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 from typing import NamedTuple, Protocol
 
 from archmetrics.changeset.locations import Location
@@ -206,14 +209,62 @@ class ExcludedFile:
         return {"path": self.path, "reason": self.reason}
 
 
-@dataclass(frozen=True, slots=True)
+class PlainLike(Protocol):
+    """Unchanged elements kept as columns, their change sets made when asked for
+    (changeset/unchanged.py, ``PlainElements``)."""
+
+    @property
+    def names(self) -> tuple[str, ...]: ...
+
+    def __len__(self) -> int: ...
+
+    def changes(self) -> Iterator[ElementChange]: ...
+
+    def record(self, name: str) -> str: ...
+
+
+def _element_name(change: ElementChange) -> str:
+    return change.element
+
+
+@dataclass(frozen=True, eq=False)
 class ChangeReport:
-    """Everything one base..new comparison measured: per location, total, elements, exclusions."""
+    """Everything one base..new comparison measured: per location, total, elements, exclusions.
+
+    ``computed``: the change sets made; ``plain``: unchanged elements kept as columns (a
+    diff of two trees that share most files), whose change sets :attr:`elements` makes when
+    first read. Two reports are equal when what they report is."""
 
     locations: tuple[tuple[Location, Summary], ...]  # always base, new, framework, in that order
     total: Summary
-    elements: tuple[ElementChange, ...]
+    computed: tuple[ElementChange, ...]  # sorted by element name
     excluded: tuple[ExcludedFile, ...]
+    plain: PlainLike | None = None
+
+    @cached_property
+    def elements(self) -> tuple[ElementChange, ...]:
+        """Every element's change set, sorted by element name."""
+        if not self.plain:
+            return self.computed
+        return tuple(heapq.merge(self.computed, self.plain.changes(), key=_element_name))
+
+    def changed(self) -> list[ElementChange]:
+        """The elements whose status is not unchanged (without making the plain ones)."""
+        return [e for e in self.computed if e.status is not Status.UNCHANGED]
+
+    def unchanged_count(self) -> int:
+        return len(self.plain or ()) + sum(e.status is Status.UNCHANGED for e in self.computed)
+
+    def _compared(self) -> tuple[object, ...]:
+        return (self.locations, self.total, self.elements, self.excluded)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, ChangeReport):
+            return NotImplemented
+        return self._compared() == other._compared()
+
+    def __hash__(self) -> int:
+        return hash(self._compared())
 
     def location(self, location: Location) -> Summary:
         """The summary S(L) of one location."""

@@ -49,7 +49,7 @@ def scan_findings(report: ScanReport) -> list[Finding]:
 
 def _most_changed(report: DiffReport) -> str | None:
     """The file of the element with the most statements added, removed and modified."""
-    changed = [e for e in report.change.elements if e.files and e.added + e.removed + e.modified]
+    changed = [e for e in report.change.changed() if e.files and e.added + e.removed + e.modified]
     if not changed:
         return None
     top = max(changed, key=lambda e: (e.added + e.removed + e.modified, e.element))

@@ -137,7 +137,7 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
         bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
     tail = ["\n".join(bullets) + "\n"] if bullets else []
-    changed = [e for e in report.change.elements if e.status.value != "unchanged"]
+    changed = report.change.changed()
     if changed:
         budget = COMMENT_LIMIT - _ROOM - len("\n".join(parts + tail))
         parts += _elements(changed, budget, max_rows)

@@ -149,12 +149,10 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
         summary.add_column(column, justify="right")
     for row in diff_rows.summary_rows(report):
         summary.add_row(*row)
-    changed = [
-        diff_rows.element_row(e) for e in report.change.elements if e.status.value != "unchanged"
-    ]
+    changed = [diff_rows.element_row(e) for e in report.change.changed()]
     least_useful = ("d_e", "d_a", "s_e", "s_a", "location", "λ pre", "v_g pre")
     detail = rows_table("elements", diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
-    unchanged = sum(e.status.value == "unchanged" for e in report.change.elements)
+    unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
