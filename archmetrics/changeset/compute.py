@@ -57,9 +57,7 @@ def coupling_by_element(report: CouplingReport) -> dict[str, Coupling]:
     return {e.element.name: Coupling(e.s_a, e.s_e, e.d_a, e.d_e) for e in report.elements}
 
 
-def _sums(
-    elements: Sequence[ElementChange], plain: tuple[Metrics, Metrics] | None = None
-) -> Sums:
+def _sums(elements: Sequence[ElementChange], plain: tuple[Metrics, Metrics] | None = None) -> Sums:
     """Σ_i over the change sets of one location (eqs. 6.2, 6.5, 6.7, 6.9, 6.16-6.18, 6.31);
     ``plain``: the sums of its unchanged elements kept as columns, before and after."""
     pre = [e.pre for e in elements if e.pre is not None]
@@ -137,8 +135,8 @@ def compute_change(
             notes += [(change.location, n) for n in element_notes]
     if unchanged and unchanged.excluded:
         excluded = sorted([*excluded, *unchanged.excluded], key=lambda x: (x.path, x.reason))
-    kept = PlainElements(tuple(plain), rows, after, dynamic_pre_zero) if plain else None
-    return report_of(changes, excluded, side_notes(sides), notes, kept)
+    columns = PlainElements(tuple(plain), rows, after or {}, dynamic_pre_zero) if plain else None
+    return report_of(changes, excluded, side_notes(sides), notes, columns)
 
 
 def report_of(

@@ -135,8 +135,8 @@ class ElementChange(NamedTuple):
             "location": location._value_,
             "files": list(files),
             "status": status._value_,
-            "pre": None if pre is None else dict(zip(_METRIC_FIELDS, pre)),
-            "post": None if post is None else dict(zip(_METRIC_FIELDS, post)),
+            "pre": None if pre is None else dict(zip(_METRIC_FIELDS, pre, strict=True)),
+            "post": None if post is None else dict(zip(_METRIC_FIELDS, post, strict=True)),
             "added": added,
             "removed": removed,
             "modified": modified,
@@ -220,7 +220,7 @@ class PlainLike(Protocol):
 
     def changes(self) -> Iterator[ElementChange]: ...
 
-    def record(self, name: str) -> str: ...
+    def records(self) -> list[dict[str, JsonValue]]: ...
 
 
 def _element_name(change: ElementChange) -> str:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from json.encoder import encode_basestring
 from typing import NamedTuple
 
 from archmetrics.changeset.elements import (
@@ -29,6 +28,7 @@ from archmetrics.changeset.model import (
     ElementChange,
     ExcludedFile,
     FilePair,
+    JsonValue,
     MeasuredFile,
     Metrics,
     Status,
@@ -148,31 +148,31 @@ class PlainElements:
             sums[location] = (pre, post)
         return sums
 
-    def record(self, name: str) -> str:
-        """The element's record in a diff's JSON document, where the document's
-        ``elements`` hold it (four spaces in): the text ``json.dumps(change.to_dict(),
-        indent=2, ensure_ascii=False)`` gives, each line after the first indented by four,
-        made by formatting instead of a dictionary per element."""
-        row, found = self.rows[name], self.values[name]
-        files = row[0]
-        listed = (
-            "[\n        " + ",\n        ".join(map(encode_basestring, files)) + "\n      ]"
-            if files
-            else "[]"
-        )
-        numbers = (*row[3:], *found)
-        before = (*row[3:], found[0], found[1], 0, 0) if self.dynamic_pre_zero else numbers
-        return _RECORD % (
-            encode_basestring(name), row[1]._value_, listed, *before, *numbers
-        )
+    def records(self) -> list[dict[str, JsonValue]]:
+        """Each element's ``to_dict`` (its change set's JSON record), in ``names`` order,
+        made from the columns: a dictionary per element and one per metrics tuple, where
+        the change set would make three tuples as well."""
+        rows, values, zero = self.rows, self.values, self.dynamic_pre_zero
+        fields = _METRIC_FIELDS
+        made: list[dict[str, JsonValue]] = []
+        for name in self.names:
+            row, found = rows[name], values[name]
+            post: dict[str, JsonValue] = dict(zip(fields, row[3:] + tuple(found), strict=True))
+            pre: dict[str, JsonValue] = {**post, "d_a": 0, "d_e": 0} if zero else post
+            made.append(
+                {
+                    "element": name,
+                    "location": row[1]._value_,
+                    "files": list(row[0]),
+                    "status": "unchanged",
+                    "pre": pre,
+                    "post": post,
+                    "added": 0,
+                    "removed": 0,
+                    "modified": 0,
+                }
+            )
+        return made
 
 
-_METRICS_TEXT = "{\n" + ",\n".join(
-    f'        "{field}": %d' for field in Metrics._fields
-) + "\n      }"
-_RECORD = (
-    '{\n      "element": %s,\n      "location": "%s",\n      "files": %s,\n'
-    '      "status": "unchanged",\n'
-    f'      "pre": {_METRICS_TEXT},\n      "post": {_METRICS_TEXT},\n'
-    '      "added": 0,\n      "removed": 0,\n      "modified": 0\n    }'
-)
+_METRIC_FIELDS = Metrics._fields

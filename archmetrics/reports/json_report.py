@@ -9,7 +9,7 @@ from operator import itemgetter
 from typing import Any
 
 from archmetrics.changeset.accuracy import Accuracy
-from archmetrics.changeset.model import ElementChange, PlainLike
+from archmetrics.changeset.model import ChangeReport
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
@@ -124,100 +124,64 @@ def short_exponent(text: str) -> bool:
     return False
 
 
-def _by_orjson(document: dict[str, Any]) -> str | None:
+def _indented(document: dict[str, Any]) -> str:
     """``json.dumps(document, indent=2, ensure_ascii=False)`` and a newline, byte for byte,
     written by orjson in C (json's indenting encoder is pure Python: a 28,000-element diff
-    took seconds); None where orjson cannot write it as json would (a lone surrogate, an
-    integer past 64 bits, a float such as 1e-07)."""
+    took seconds). What orjson cannot write as json would (a lone surrogate, an integer past
+    64 bits, a float such as 1e-07) is left to json."""
     import orjson
 
     try:
         text = orjson.dumps(document, option=orjson.OPT_INDENT_2 | orjson.OPT_APPEND_NEWLINE)
     except TypeError:  # orjson.JSONEncodeError
-        return None
+        return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
     written = text.decode()
-    return None if short_exponent(written) else written
-
-
-def _indented(document: dict[str, Any]) -> str:
-    """``json.dumps(document, indent=2, ensure_ascii=False)`` and a newline (``_by_orjson``
-    where it can)."""
-    written = _by_orjson(document)
-    if written is None:
+    if short_exponent(written):
         return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
     return written
 
 
-def _escaped(text: str) -> str:
-    """``json`` escapes C0 controls itself; DEL, C1 controls, line separators and lone
-    surrogates are escaped here too (``\\u0085``), so the text is valid UTF-8 and safe to
-    print (docs/security.md)."""
+def dumps(document: dict[str, Any]) -> str:
+    """The document as JSON text. ``json`` escapes C0 controls itself; DEL, C1 controls, line
+    separators and lone surrogates are escaped here too (``\\u0085``), so the text is valid
+    UTF-8 and safe to print (docs/security.md)."""
+    text = _indented(document)
     if text.isascii() and "\x7f" not in text:  # nothing to escape (both checks in C, fast)
         return text
     return _UNPRINTABLE.sub(lambda found: f"\\u{ord(found.group()):04x}", text)
-
-
-def dumps(document: dict[str, Any]) -> str:
-    """The document as JSON text, escaped (``_escaped``)."""
-    return _escaped(_indented(document))
 
 
 def render_scan(report: ScanReport) -> str:
     return dumps(scan_dict(report))
 
 
-def diff_dict(report: DiffReport, elements: list[Any] | None = None) -> dict[str, Any]:
-    """The diff document (``elements``: its element records, if made already)."""
+def diff_dict(report: DiffReport) -> dict[str, Any]:
     failed = {f.gate.text for f in report.failures}
     return {
         "schema": DIFF_SCHEMA,
         "base": report.base,
         "head": report.head,
         "locations": {name: s.to_dict() for name, s in report.summaries().items()},
-        "elements": (
-            [e.to_dict() for e in report.change.elements] if elements is None else elements
-        ),
+        "elements": element_records(report.change),
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
         "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
     }
 
 
+def element_records(change: ChangeReport) -> list[dict[str, Any]]:
+    """Every element's record, sorted by name: the unchanged elements a report keeps as
+    columns written from them (``PlainElements.records``), without making their change
+    sets (in a large tree with one file changed, nearly all of them)."""
+    if not change.plain:
+        return [e.to_dict() for e in change.elements]
+    made = [(e.element, e.to_dict()) for e in change.computed]
+    kept = zip(change.plain.names, change.plain.records(), strict=True)
+    return [record for _, record in heapq.merge(made, kept, key=itemgetter(0))]
+
+
 def render_diff(report: DiffReport) -> str:
-    plain = report.change.plain
-    if plain:
-        text = _spliced(report, plain)
-        if text is not None:
-            return text
     return dumps(diff_dict(report))
-
-
-def _spliced(report: DiffReport, plain: PlainLike) -> str | None:
-    """The diff document of a report that keeps unchanged elements as columns, each of
-    their records written from the columns (``PlainElements.record``) and given to orjson
-    as a fragment, the other records as dictionaries: the same text as ``dumps`` of the
-    whole document, without a change set and a dictionary per unchanged element. None
-    where ``dumps`` would not use orjson (then it writes the document)."""
-    import orjson
-
-    def made(change: ElementChange) -> tuple[str, bytes | None]:
-        text = orjson.dumps(change.to_dict(), option=orjson.OPT_INDENT_2)
-        return change.element, text.replace(b"\n", b"\n    ")
-
-    merged = heapq.merge(
-        map(made, report.change.computed),
-        ((name, None) for name in plain.names),
-        key=itemgetter(0),
-    )
-    try:
-        records = [
-            orjson.Fragment(plain.record(name).encode() if text is None else text)
-            for name, text in merged
-        ]
-    except (TypeError, UnicodeEncodeError):  # a lone surrogate: json writes it
-        return None
-    written = _by_orjson(diff_dict(report, records))
-    return None if written is None else _escaped(written)
 
 
 def series_dict(report: SeriesReport) -> dict[str, Any]:

@@ -84,13 +84,17 @@ def encode(state: TreeState) -> bytes:
         "measured": [at[p] for p in index.paths],
         "elements": [[e.name for e in index.elements], members, sizes, kinds, kind_sizes],
         "deps": [
-            [at[p] for p in dep_files], dep_sizes,
+            [at[p] for p in dep_files],
+            dep_sizes,
             [-1 if d.target_file is None else at[d.target_file] for d in deps],
-            [_RESOLUTIONS.index(d.resolution) for d in deps], [d.name for d in deps],
+            [_RESOLUTIONS.index(d.resolution) for d in deps],
+            [d.name for d in deps],
         ],
         "sites": [
-            [at[p] for p in site_files], site_sizes,
-            [_ROLES.index(role) for role, _ in sites], [key for _, key in sites],
+            [at[p] for p in site_files],
+            site_sizes,
+            [_ROLES.index(role) for role, _ in sites],
+            [key for _, key in sites],
         ],
         "values": [n for e in index.elements for n in index.values[e.name]],
         "groups": _groups(state, at),
@@ -252,7 +256,8 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
         numbers[2::5],
         [bool(f & _PARSED) for f in flags],
         [bool(f & _GENERATED) for f in flags],
-        [tuple(warnings.get(i, ())) for i in range(count)] if warnings else repeat(()),
+        [tuple(warnings.get(i, ())) for i in range(count)] if warnings else [()] * count,
+        strict=True,
     )
     return tuple(map(_new, repeat(FileRow), fields))  # rows checked above: made directly
 
@@ -285,9 +290,9 @@ def _grouped(names: list[str], members: object, sizes: object, files: list[str],
     lengths = _ints(sizes, 0, count + 1, len(names))
     groups = _split(_ints(members, 0, count), lengths)
     pick = files.__getitem__
-    return tuple(
-        map(Element, names, [tuple(map(pick, g)) for g in groups], kinds or repeat(()))
-    )
+    members_of = [tuple(map(pick, g)) for g in groups]
+    fields = zip(names, members_of, kinds or [()] * len(names), strict=True)
+    return tuple(map(_new, repeat(Element), fields))
 
 
 def _elements(value: object, files: list[str], languages: list[str]) -> tuple[Element, ...]:
@@ -394,6 +399,7 @@ def _table(value: object, groups: Sequence[Element], files: list[str]) -> dict[s
         sums[0::3],
         sums[1::3],
         sums[2::3],
+        strict=True,
     )
     made = map(_new, repeat(ElementRow), fields)  # checked above: made directly
     return {name: row for name, row, code in zip(named, made, locations, strict=True) if code >= 0}
