@@ -40,12 +40,19 @@ _DIGESTS: dict[int, tuple[RuleSet, str]] = {}
 
 
 def packs_digest(packs: RuleSet) -> str:
-    """A digest of the rule packs as loaded (their ``repr``: every rule, field by field),
-    made once per loaded set: a key a cached record depends on (a tree's state, each file's
-    link sites) names the packs by it, and the ``repr`` of the shipped packs alone is 90 ms."""
+    """A digest of the rule packs in force, made once per loaded set: a key a cached record
+    depends on (a tree's state, each file's link sites) names the packs by it. Packs read
+    from text are named by their names, sources and the SHA-256 of their text (the keys
+    also hold archmetrics's code, which decides what a text parses to); a pack made in
+    memory by its ``repr``, every rule field by field (the shipped packs' ``repr`` took
+    90 ms, every diff)."""
     known = _DIGESTS.get(id(packs))
     if known is None or known[0] is not packs:
-        known = (packs, hashlib.sha256(repr(packs).encode()).hexdigest())
+        parts = [
+            f"text\0{pack.name}\0{pack.source}\0{pack.digest}" if pack.digest else f"repr\0{pack!r}"
+            for pack in packs.packs
+        ]
+        known = (packs, hashlib.sha256("\0\0".join(parts).encode()).hexdigest())
         _DIGESTS.clear()  # one set of packs per command: keep the last
         _DIGESTS[id(packs)] = known
     return known[1]

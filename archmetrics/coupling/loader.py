@@ -8,6 +8,8 @@ Packs come from three places, in this order: the built-in packs shipped in
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import os
 import stat
 import tomllib
@@ -48,7 +50,8 @@ def load_rule_pack(source: PackSource) -> RulePack:
         raise RulePackError(name, None, None, f"not valid TOML: {error}") from error
     except RecursionError:
         raise RulePackError(name, None, None, "not valid TOML: nested too deeply") from None
-    return parse_pack(data, name)
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return dataclasses.replace(parse_pack(data, name), digest=digest)
 
 
 MAX_PACK_BYTES = 1 << 20

@@ -160,6 +160,7 @@ class RulePack:
     description: str
     rules: tuple[Rule, ...]
     configuration: tuple[ConfigRule, ...] = ()
+    digest: str = ""  # SHA-256 of the text it was read from ("": made in memory)
 
 
 @dataclass(frozen=True, slots=True)
