@@ -31,6 +31,7 @@ from archmetrics.sources.codec import CodecError
 FORMAT = 3
 _PARSED, _GENERATED = 1, 2
 _SEVERITIES = tuple(s.value for s in Severity)
+_SEVERITY_MEMBERS = tuple(Severity)
 _RESOLUTIONS = ("internal", "external", "unresolved")
 _ROLES = ("initiate", "receive", "use")
 _LOCATIONS = tuple(loc for loc in Location)
@@ -206,13 +207,13 @@ def decode(data: bytes) -> TreeState:
     count = len(files)
     languages = _texts(document.get("languages"))
     rows = _rows(document, files, languages)
-    paths = tuple(files[i] for i in _ints(document.get("measured"), 0, count))
+    paths = tuple(map(files.__getitem__, _ints(document.get("measured"), 0, count)))
     elements = _elements(document.get("elements"), files, languages)
     deps = DepTable.read(document.get("deps"), files)
     sites = _sites(document.get("sites"), files)
     numbers = _ints(document.get("values"), 0, 1 << 62, 4 * len(elements))
     columns = (numbers[0::4], numbers[1::4], numbers[2::4], numbers[3::4])
-    named = (e.name for e in elements)
+    named = [e.name for e in elements]
     values: dict[str, Values] = dict(zip(named, zip(*columns, strict=True), strict=True))
     index = CouplingIndex(paths, elements, deps, sites, values)
     _consistent(files, index, deps)
@@ -244,7 +245,7 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
             raise _bad("a malformed warning")
         i, line, message, severity = entry
         warnings.setdefault(i, []).append(
-            ParseWarning(files[i], line, message, Severity(_SEVERITIES[severity]))
+            ParseWarning(files[i], line, message, _SEVERITY_MEMBERS[severity])
         )
     flags = numbers[3::5]
     fields = zip(
@@ -299,9 +300,24 @@ def _elements(value: object, files: list[str], languages: list[str]) -> tuple[El
     names, members, sizes, kinds, kind_sizes = _lists(value, 5)
     names = _texts(names)
     codes = _ints(kinds, 0, len(languages))
-    spans = _split(codes, _ints(kind_sizes, 0, len(languages) + 1, len(names)))
-    pick = languages.__getitem__
-    langs = [tuple(map(pick, span)) for span in spans]
+    lengths = _ints(kind_sizes, 0, len(languages) + 1, len(names))
+    if sum(lengths) != len(codes):
+        raise _bad("lengths that do not add up")
+    # each element's languages, one tuple per distinct list (most elements hold one file)
+    ones = [(language,) for language in languages]
+    made: dict[tuple[int, ...], tuple[str, ...]] = {}
+    langs: list[tuple[str, ...]] = []
+    start = 0
+    for end in accumulate(lengths):
+        if end - start == 1:
+            langs.append(ones[codes[start]])
+        else:
+            key = tuple(codes[start:end])
+            found = made.get(key)
+            if found is None:
+                found = made[key] = tuple(map(languages.__getitem__, key))
+            langs.append(found)
+        start = end
     return _grouped(names, members, sizes, files, langs)
 
 
