@@ -112,7 +112,7 @@ class PlainElements:
     same: their change sets follow from their rows and values alone, so a report keeps
     them as these columns and makes an :class:`ElementChange` of one only when asked
     (``change``). A tree of 28,000 elements in which one file changed is mostly such
-    elements; the JSON report writes them from here (``record``) and the location sums
+    elements; the JSON report writes them from here (``records``) and the location sums
     add them up from here (``sums``). ``names`` are sorted."""
 
     names: tuple[str, ...]
