@@ -35,6 +35,9 @@ log = logging.getLogger("robosoa.zmq")
 
 ANNOUNCE = b"a:"  # the location service's channel of publisher-set changes
 MAX_TRACKED = 65536  # (publisher, channel) sequence numbers kept; then forgotten (no loss seen)
+BATCH = 256  # messages read per wake-up before commands are looked at again
+BATCH_BYTES = 256 * 1024  # a batch is handed out once its messages hold this many bytes
+Offer = tuple[tuple[Sink, ...], Message, int, float]  # sinks, message, size, expiry
 _NOBLOCK = int(zmq.NOBLOCK)
 
 
@@ -146,25 +149,38 @@ class Feed:
         if sinks:
             hand_out(sinks, frames, expires, block, channel, self._options)
 
-    def _deliver(self, frames: list[bytes], hold: bool) -> bool:
-        """Hand one message to its sinks; False if a reliable one refused it (held back:
-        only for messages of the reliable socket, ``hold``)."""
+    def _deliver(self, frames: list[bytes]) -> bool:
+        """Hand one message of the reliable socket to its sinks; False if one refused it
+        (then it is held back, and offered again at ``room``)."""
+        taken = self._take(frames)
+        if taken is None:
+            return True
+        sinks, msg, size, expires = taken
+        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, True))
+        if not refused:
+            return True
+        self._held = (msg, size, expires, refused)
+        return False
+
+    def _take(self, frames: list[bytes]) -> Offer | None:
+        """One message checked and decoded, with the sinks it goes to; None when it goes to
+        none (an announcement, a mark, nobody subscribed, or malformed: counted)."""
         head = frames[0]
         cut = head.find(b"\0")
         channel = head[:cut]
         if channel == ANNOUNCE:
             self._announced()
-            return True
+            return None
         if cut < 0 or len(head) < cut + 1 + META.size:
             self._rejected("broadcast")
-            return True
+            return None
         sinks = self._sinks.get(channel)
         if sinks is None:
-            return True
+            return None
         publisher, seq, expires = META.unpack_from(head, cut + 1)
         self._sequence(publisher, channel, seq, expires == MARK)
         if expires == MARK:
-            return True
+            return None
         body = head[cut + 1 + META.size:]
         try:
             msg = decode_frames([body, *frames[1:]] if len(frames) > 1 else [body],
@@ -172,19 +188,9 @@ class Feed:
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
-            return True
+            return None
         size = len(head) if len(frames) == 1 else sum(map(len, frames))
-        refused: tuple[Sink, ...]
-        if len(sinks) == 1:
-            if sinks[0](msg, size, expires, hold):
-                return True
-            refused = sinks
-        else:
-            refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
-            if not refused:
-                return True
-        self._held = (msg, size, expires, refused)
-        return False
+        return sinks, msg, size, expires
 
     def _sequence(self, publisher: int, channel: bytes, seq: int, mark: bool) -> None:
         """Count the messages of ``publisher`` on ``channel`` that were skipped (up to its
@@ -224,9 +230,9 @@ class Feed:
                     self._waker.drain()
                     self._apply((lossy, reliable), peers)
                 if lossy in events:
-                    self._drain(lossy, False)
+                    self._drain(lossy)
                 if reliable in events and self._held is None:
-                    self._drain(reliable, True)
+                    self._drain_reliable(reliable)
                 if paused != (self._held is not None):  # hold the reliable socket back
                     paused = not paused
                     poller.modify(reliable, 0 if paused else zmq.POLLIN)
@@ -238,15 +244,43 @@ class Feed:
                 if done is not None:
                     done.set()
 
-    def _drain(self, sub: zmq.Socket[bytes], hold: bool) -> None:
-        """Deliver a batch of what ``sub`` holds; stop early at a held-back message."""
-        for _ in range(256):  # then look at commands again
+    def _drain(self, sub: zmq.Socket[bytes]) -> None:
+        """Deliver what the best-effort socket holds in batches: messages are read and
+        decoded first and handed out together once ``BATCH_BYTES`` have gathered or the
+        socket is empty, so a subscription's reader is woken once per batch rather than
+        once or twice per message, and large messages still go one by one (a batch of them
+        would overflow a subscription's byte budget at once). See docs/runtime.md,
+        Performance. Best-effort sinks never refuse."""
+        batch: list[Offer] = []
+        gathered = 0
+        for _ in range(BATCH):  # then look at commands again
+            try:
+                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+            except zmq.Again:
+                break
+            try:
+                taken = self._take(frames)
+            except Exception:  # never let one message end the subscriber thread
+                log.exception("broadcast delivery failed")
+                continue
+            if taken is not None:
+                batch.append(taken)
+                gathered += taken[2]
+                if gathered >= BATCH_BYTES:
+                    _hand_out(batch)
+                    gathered = 0
+        _hand_out(batch)
+
+    def _drain_reliable(self, sub: zmq.Socket[bytes]) -> None:
+        """Deliver what the reliable socket holds, one message at a time; stop at a
+        message a subscription refused (held back until it has room)."""
+        for _ in range(BATCH):
             try:
                 frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
             except zmq.Again:
                 return
             try:
-                if not self._deliver(frames, hold):
+                if not self._deliver(frames):
                     return
             except Exception:  # never let one message end the subscriber thread
                 log.exception("broadcast delivery failed")
@@ -272,6 +306,14 @@ class Feed:
         self._waker.wake()
         self._thread.join(timeout=5.0)
         self._waker.close()
+
+
+def _hand_out(batch: list[Offer]) -> None:
+    """Give every message of ``batch`` to its best-effort sinks, in order; empty it."""
+    for sinks, msg, size, expires in batch:
+        for sink in sinks:
+            sink(msg, size, expires, False)
+    batch.clear()
 
 
 def _quietly(call: Callable[[str], object], endpoint: str) -> None:
