@@ -25,11 +25,11 @@ import zmq
 
 from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
-from robosoa.message import Message, decode_frames
+from robosoa.message import Message, decode, decode_frames
 from robosoa.transports.base import BusOptions, Sink, hand_out
 from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import MARK, META, prefix
-from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
+from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_message
 
 log = logging.getLogger("robosoa.zmq")
 
@@ -178,13 +178,19 @@ class Feed:
         if sinks is None:
             return None
         publisher, seq, expires = META.unpack_from(head, cut + 1)
-        self._sequence(publisher, channel, seq, expires == MARK)
-        if expires == MARK:
-            return None
+        key = (publisher, channel)
+        if expires == MARK or self._last.get(key) != seq - 1:
+            self._sequence(publisher, channel, seq, expires == MARK)
+            if expires == MARK:
+                return None
+        else:  # the next message of its stream, the common case: nothing skipped
+            self._last[key] = seq
         body = head[cut + 1 + META.size:]
+        options = self._options
         try:
-            msg = decode_frames([body, *frames[1:]] if len(frames) > 1 else [body],
-                                self._options.max_message, self._options.max_depth)
+            msg = (decode(body, options.max_message, options.max_depth) if len(frames) == 1
+                   else decode_frames([body, *frames[1:]], options.max_message,
+                                      options.max_depth))
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
@@ -255,7 +261,7 @@ class Feed:
         gathered = 0
         for _ in range(BATCH):  # then look at commands again
             try:
-                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
             except zmq.Again:
                 break
             try:
@@ -276,7 +282,7 @@ class Feed:
         message a subscription refused (held back until it has room)."""
         for _ in range(BATCH):
             try:
-                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
             except zmq.Again:
                 return
             try:

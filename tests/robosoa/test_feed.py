@@ -1,7 +1,8 @@
 """The subscriber's feed hands out what it reads in batches: small messages together once the
 socket is empty, large ones one by one (a batch of them would overflow a subscription's byte
 budget before its reader could take any). Real ZeroMQ sockets on inproc; the feed's own
-``_drain`` reads a SUB socket of the test's, whose class only counts the reads."""
+``_drain`` reads a SUB socket of the test's, whose class only counts the reads. And the
+feed's way of taking a whole message off a socket (``recv_message``)."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from robosoa.message import Message
 from robosoa.transports.base import BusOptions
 from robosoa.transports.zmq_outlet import META
 from robosoa.transports.zmq_pubsub import BATCH_BYTES, Feed
+from robosoa.transports.zmq_sockets import recv_message
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -95,3 +97,29 @@ def test_large_messages_are_handed_out_one_by_one(
     assert [n for n, _ in handed] == [1, 2, 3, 4, 5]
     reads = [r for _, r in handed]
     assert reads == list(range(reads[0], reads[0] + 5))  # each before the next is read
+
+
+def test_recv_message_takes_whole_messages_and_cuts_off_extra_frames() -> None:
+    """One-frame messages, messages of several frames and one of more frames than allowed
+    come off the socket whole, in order; the frames past the limit are read and thrown
+    away (the message comes back one frame longer than the limit, which decoders refuse)."""
+    ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
+    pull, push = ctx.socket(zmq.PULL), ctx.socket(zmq.PUSH)
+    address = f"inproc://recv-{uuid.uuid4().hex}"
+    pull.bind(address)
+    push.connect(address)
+    try:
+        push.send(b"one")
+        push.send_multipart([b"head", b"a", b"b"])
+        push.send_multipart([b"many", *[b"x"] * 10])
+        push.send(b"last")
+        assert recv_message(pull, 0, 4) == [b"one"]
+        assert recv_message(pull, 0, 4) == [b"head", b"a", b"b"]
+        assert recv_message(pull, 0, 4) == [b"many", b"x", b"x", b"x", b"x"]
+        assert recv_message(pull, 0, 4) == [b"last"]
+        with pytest.raises(zmq.Again):
+            recv_message(pull, zmq.NOBLOCK, 4)
+    finally:
+        pull.close(0)
+        push.close(0)
+        ctx.term()
