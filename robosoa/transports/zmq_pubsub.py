@@ -59,7 +59,7 @@ class Feed:
         self._commands: deque[tuple[str, object, threading.Event | None]] = deque()
         self._waker = Waker(ctx)
         self._last: dict[tuple[int, bytes], int] = {}
-        self._held: tuple[Message, int, float, tuple[Sink, ...]] | None = None  # refused
+        self._held: Offer | None = None  # a reliable message refused, for the sinks that did
         self._stopped = threading.Event()
         self._announce = announce
         self._thread = threading.Thread(target=self._run, daemon=True, name="robosoa-sub")
@@ -134,11 +134,17 @@ class Feed:
                     done.set()
 
     def _retry(self) -> None:
-        """Offer the held-back message to the sinks that refused it (feed thread)."""
+        """Offer the held-back message again to the sinks that refused it (feed thread)."""
         if self._held is not None:
-            msg, size, expires, sinks = self._held
-            waiting = tuple(s for s in sinks if not s(msg, size, expires, True))
-            self._held = (msg, size, expires, waiting) if waiting else None
+            self._offer(self._held)
+
+    def _offer(self, offer: Offer) -> bool:
+        """Offer a reliable message to its sinks; whether all took it. The message stays
+        held back for those that refused (offered again at ``room``)."""
+        sinks, msg, size, expires = offer
+        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, True))
+        self._held = (refused, msg, size, expires) if refused else None
+        return not refused
 
     def local(self, channel: str, frames: list[bytes], expires: float,
               block: float | None) -> None:
@@ -148,19 +154,6 @@ class Feed:
         sinks = self._sinks.get(prefix(channel)[:-1])
         if sinks:
             hand_out(sinks, frames, expires, block, channel, self._options)
-
-    def _deliver(self, frames: list[bytes]) -> bool:
-        """Hand one message of the reliable socket to its sinks; False if one refused it
-        (then it is held back, and offered again at ``room``)."""
-        taken = self._take(frames)
-        if taken is None:
-            return True
-        sinks, msg, size, expires = taken
-        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, True))
-        if not refused:
-            return True
-        self._held = (msg, size, expires, refused)
-        return False
 
     def _take(self, frames: list[bytes]) -> Offer | None:
         """One message checked and decoded, with the sinks it goes to; None when it goes to
@@ -251,12 +244,10 @@ class Feed:
                     done.set()
 
     def _drain(self, sub: zmq.Socket[bytes]) -> None:
-        """Deliver what the best-effort socket holds in batches: messages are read and
-        decoded first and handed out together once ``BATCH_BYTES`` have gathered or the
-        socket is empty, so a subscription's reader is woken once per batch rather than
-        once or twice per message, and large messages still go one by one (a batch of them
-        would overflow a subscription's byte budget at once). See docs/runtime.md,
-        Performance. Best-effort sinks never refuse."""
+        """Deliver what the best-effort socket holds in batches, read and decoded first and
+        handed out together (a subscription's reader is woken once per batch, not every few
+        messages), or as soon as they hold ``BATCH_BYTES`` (so large messages go one by one,
+        not several at once past a byte budget). docs/runtime.md, Performance."""
         batch: list[Offer] = []
         gathered = 0
         for _ in range(BATCH):  # then look at commands again
@@ -286,7 +277,8 @@ class Feed:
             except zmq.Again:
                 return
             try:
-                if not self._deliver(frames):
+                taken = self._take(frames)
+                if taken is not None and not self._offer(taken):
                     return
             except Exception:  # never let one message end the subscriber thread
                 log.exception("broadcast delivery failed")
