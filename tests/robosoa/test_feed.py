@@ -24,7 +24,8 @@ pytestmark = pytest.mark.timeout(60)
 
 
 class CountingSocket(zmq.Socket[bytes]):
-    """A real ZeroMQ socket that counts the messages taken off it (first frames)."""
+    """A real ZeroMQ socket that counts its ``recv`` calls: the frames taken off it, one per
+    message in these tests (every message is one frame)."""
 
     reads = 0
 
