@@ -8,10 +8,8 @@ everywhere, and never raises anything but :class:`~robosoa.errors.InvalidMessage
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
-import re
 from typing import Any
 
 import orjson
@@ -39,8 +37,17 @@ def _finite(text: str) -> float:
 
 # built once: json.loads(..., parse_constant=...) would build a decoder per call
 _DECODE = json.JSONDecoder(parse_constant=_no_constant, parse_float=_finite).decode
-_LONG_NUMBER = re.compile(rb"[0-9]{19}")  # maybe an integer orjson cannot keep exact
+_ZEROS = bytes.maketrans(b"123456789", b"000000000")  # every ASCII digit becomes "0"
+_LONG_RUN = b"0" * 19  # 19 digits in a row: maybe an integer orjson cannot keep exact
 _UNREAD = object()
+
+
+def long_number(raw: bytes) -> bool:
+    """Whether ``raw`` holds 19 or more ASCII digits in a row (``re`` ``[0-9]{19}``): every
+    digit turned into "0" by ``bytes.translate``, then one substring search, both in C;
+    about a fifth of the time of the regular expression on an envelope, which tries its
+    character class at every byte."""
+    return _LONG_RUN in raw.translate(_ZEROS)
 
 
 def depth(value: Any, limit: int) -> int:
@@ -60,6 +67,15 @@ def depth(value: Any, limit: int) -> int:
             return deepest
         stack.extend((child, level + 1) for child in children)
     return deepest
+
+
+def _orjson(raw: bytes) -> Any:
+    """orjson's reading, or ``_UNREAD`` where it refuses (json then reads it and says why);
+    a plain ``try``, not ``contextlib.suppress``, which builds an object per call."""
+    try:
+        return orjson.loads(raw)
+    except orjson.JSONDecodeError:
+        return _UNREAD
 
 
 def _standard(raw: bytes | str, max_depth: int) -> Any:
@@ -87,9 +103,8 @@ def load_json(raw: bytes | str, max_bytes: int = MAX_MESSAGE, max_depth: int = M
     if len(raw) > max_bytes:
         raise LimitExceeded(f"message of {len(raw)} bytes exceeds the limit of {max_bytes}")
     data: Any = _UNREAD
-    if fast and isinstance(raw, bytes) and not _LONG_NUMBER.search(raw):
-        with contextlib.suppress(orjson.JSONDecodeError):
-            data = orjson.loads(raw)
+    if fast and isinstance(raw, bytes) and not long_number(raw):
+        data = _orjson(raw)
     if data is _UNREAD:
         data = _standard(raw, max_depth)
     if isinstance(raw, bytes):  # cheap bound first: depth <= number of opening brackets

@@ -25,16 +25,19 @@ import zmq
 
 from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import InvalidMessage
-from robosoa.message import Message, decode_frames
+from robosoa.message import Message, decode, decode_frames
 from robosoa.transports.base import BusOptions, Sink, hand_out
 from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import MARK, META, prefix
-from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_rest
+from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_message
 
 log = logging.getLogger("robosoa.zmq")
 
 ANNOUNCE = b"a:"  # the location service's channel of publisher-set changes
 MAX_TRACKED = 65536  # (publisher, channel) sequence numbers kept; then forgotten (no loss seen)
+BATCH = 256  # messages read per wake-up before commands are looked at again
+BATCH_BYTES = 256 * 1024  # a batch is handed out once its messages hold this many bytes
+Offer = tuple[tuple[Sink, ...], Message, int, float]  # sinks, message, size, expiry
 _NOBLOCK = int(zmq.NOBLOCK)
 
 
@@ -56,7 +59,7 @@ class Feed:
         self._commands: deque[tuple[str, object, threading.Event | None]] = deque()
         self._waker = Waker(ctx)
         self._last: dict[tuple[int, bytes], int] = {}
-        self._held: tuple[Message, int, float, tuple[Sink, ...]] | None = None  # refused
+        self._held: Offer | None = None  # a reliable message refused, for the sinks that did
         self._stopped = threading.Event()
         self._announce = announce
         self._thread = threading.Thread(target=self._run, daemon=True, name="robosoa-sub")
@@ -131,11 +134,17 @@ class Feed:
                     done.set()
 
     def _retry(self) -> None:
-        """Offer the held-back message to the sinks that refused it (feed thread)."""
+        """Offer the held-back message again to the sinks that refused it (feed thread)."""
         if self._held is not None:
-            msg, size, expires, sinks = self._held
-            waiting = tuple(s for s in sinks if not s(msg, size, expires, True))
-            self._held = (msg, size, expires, waiting) if waiting else None
+            self._offer(self._held)
+
+    def _offer(self, offer: Offer) -> bool:
+        """Offer a reliable message to its sinks; whether all took it. The message stays
+        held back for those that refused (offered again at ``room``)."""
+        sinks, msg, size, expires = offer
+        refused = tuple(sink for sink in sinks if not sink(msg, size, expires, True))
+        self._held = (refused, msg, size, expires) if refused else None
+        return not refused
 
     def local(self, channel: str, frames: list[bytes], expires: float,
               block: float | None) -> None:
@@ -146,45 +155,41 @@ class Feed:
         if sinks:
             hand_out(sinks, frames, expires, block, channel, self._options)
 
-    def _deliver(self, frames: list[bytes], hold: bool) -> bool:
-        """Hand one message to its sinks; False if a reliable one refused it (held back:
-        only for messages of the reliable socket, ``hold``)."""
+    def _take(self, frames: list[bytes]) -> Offer | None:
+        """One message checked and decoded, with the sinks it goes to; None when it goes to
+        none (an announcement, a mark, nobody subscribed, or malformed: counted)."""
         head = frames[0]
         cut = head.find(b"\0")
         channel = head[:cut]
         if channel == ANNOUNCE:
             self._announced()
-            return True
+            return None
         if cut < 0 or len(head) < cut + 1 + META.size:
             self._rejected("broadcast")
-            return True
+            return None
         sinks = self._sinks.get(channel)
         if sinks is None:
-            return True
+            return None
         publisher, seq, expires = META.unpack_from(head, cut + 1)
-        self._sequence(publisher, channel, seq, expires == MARK)
-        if expires == MARK:
-            return True
+        key = (publisher, channel)
+        if expires == MARK or self._last.get(key) != seq - 1:
+            self._sequence(publisher, channel, seq, expires == MARK)
+            if expires == MARK:
+                return None
+        else:  # the next message of its stream, the common case: nothing skipped
+            self._last[key] = seq
         body = head[cut + 1 + META.size:]
+        options = self._options
         try:
-            msg = decode_frames([body, *frames[1:]] if len(frames) > 1 else [body],
-                                self._options.max_message, self._options.max_depth)
+            msg = (decode(body, options.max_message, options.max_depth) if len(frames) == 1
+                   else decode_frames([body, *frames[1:]], options.max_message,
+                                      options.max_depth))
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
-            return True
+            return None
         size = len(head) if len(frames) == 1 else sum(map(len, frames))
-        refused: tuple[Sink, ...]
-        if len(sinks) == 1:
-            if sinks[0](msg, size, expires, hold):
-                return True
-            refused = sinks
-        else:
-            refused = tuple(sink for sink in sinks if not sink(msg, size, expires, hold))
-            if not refused:
-                return True
-        self._held = (msg, size, expires, refused)
-        return False
+        return sinks, msg, size, expires
 
     def _sequence(self, publisher: int, channel: bytes, seq: int, mark: bool) -> None:
         """Count the messages of ``publisher`` on ``channel`` that were skipped (up to its
@@ -224,9 +229,9 @@ class Feed:
                     self._waker.drain()
                     self._apply((lossy, reliable), peers)
                 if lossy in events:
-                    self._drain(lossy, False)
+                    self._drain(lossy)
                 if reliable in events and self._held is None:
-                    self._drain(reliable, True)
+                    self._drain_reliable(reliable)
                 if paused != (self._held is not None):  # hold the reliable socket back
                     paused = not paused
                     poller.modify(reliable, 0 if paused else zmq.POLLIN)
@@ -238,15 +243,42 @@ class Feed:
                 if done is not None:
                     done.set()
 
-    def _drain(self, sub: zmq.Socket[bytes], hold: bool) -> None:
-        """Deliver a batch of what ``sub`` holds; stop early at a held-back message."""
-        for _ in range(256):  # then look at commands again
+    def _drain(self, sub: zmq.Socket[bytes]) -> None:
+        """Deliver what the best-effort socket holds in batches, read and decoded first and
+        handed out together (a subscription's reader is woken once per batch, not every few
+        messages), or as soon as they hold ``BATCH_BYTES`` (so large messages go one by one,
+        not several at once past a byte budget). docs/runtime.md, Performance."""
+        batch: list[Offer] = []
+        gathered = 0
+        for _ in range(BATCH):  # then look at commands again
             try:
-                frames = recv_rest(sub, sub.recv(_NOBLOCK), MAX_BLOBS + 2)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
+            except zmq.Again:
+                break
+            try:
+                taken = self._take(frames)
+            except Exception:  # never let one message end the subscriber thread
+                log.exception("broadcast delivery failed")
+                continue
+            if taken is not None:
+                batch.append(taken)
+                gathered += taken[2]
+                if gathered >= BATCH_BYTES:
+                    _hand_out(batch)
+                    gathered = 0
+        _hand_out(batch)
+
+    def _drain_reliable(self, sub: zmq.Socket[bytes]) -> None:
+        """Deliver what the reliable socket holds, one message at a time; stop at a
+        message a subscription refused (held back until it has room)."""
+        for _ in range(BATCH):
+            try:
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
             except zmq.Again:
                 return
             try:
-                if not self._deliver(frames, hold):
+                taken = self._take(frames)
+                if taken is not None and not self._offer(taken):
                     return
             except Exception:  # never let one message end the subscriber thread
                 log.exception("broadcast delivery failed")
@@ -272,6 +304,14 @@ class Feed:
         self._waker.wake()
         self._thread.join(timeout=5.0)
         self._waker.close()
+
+
+def _hand_out(batch: list[Offer]) -> None:
+    """Give every message of ``batch`` to its best-effort sinks, in order; empty it."""
+    for sinks, msg, size, expires in batch:
+        for sink in sinks:
+            sink(msg, size, expires, False)
+    batch.clear()
 
 
 def _quietly(call: Callable[[str], object], endpoint: str) -> None:

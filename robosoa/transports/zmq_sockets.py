@@ -92,6 +92,17 @@ def recv_rest(sock: zmq.Socket[bytes], first: bytes,
     return frames
 
 
+def recv_message(sock: zmq.Socket[bytes], flags: int = 0,
+                 limit: int = MAX_BLOBS + 1) -> list[bytes]:
+    """One whole message, as :func:`recv_rest` gives it. The first frame is taken as a
+    ``zmq.Frame``, whose ``more`` flag answers what ``getsockopt(RCVMORE)`` would (that
+    costs about 0.75 us in pyzmq, the Frame about 0.35 us): a one-frame message, the common
+    case on a subscriber, asks the socket nothing more."""
+    first = sock.recv(flags, copy=False)
+    head = first.bytes
+    return recv_rest(sock, head, limit) if first.more else [head]
+
+
 def keepalive(sock: zmq.Socket[bytes], heartbeat: float, timeout: float) -> None:
     """ZMTP heartbeats: a PING every ``heartbeat`` s; a connection that brings nothing back
     for ``timeout`` s is closed (also asked of the peer, as the TTL), so a dead or cut-off

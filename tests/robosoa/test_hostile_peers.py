@@ -14,6 +14,8 @@ import zmq
 
 import robosoa
 from robosoa.transports.zmq_location import PEER_TIMEOUT
+from robosoa.transports.zmq_outlet import MARK, META
+from robosoa.transports.zmq_pubsub import BATCH
 from robosoa.wire import MAX_DEPTH
 from tests.robosoa.conftest import FAST
 from tests.robosoa.procs import free_port, tcp_location
@@ -173,6 +175,56 @@ def test_malformed_broadcasts_are_dropped_counted_and_harmless(zmq_url: str, nam
             bus.publish(name, {"ok": 1})
             eventually(lambda: got)
             assert got[-1].payload == {"ok": 1}
+        finally:
+            pub.close(0)
+
+
+def _broadcast(channel: bytes, seq: int, body: bytes, expires: float = 0.0) -> bytes:
+    """A broadcast frame as a publisher writes it: channel, stream data, JSON."""
+    return channel + META.pack(7, seq, expires) + body
+
+
+def test_a_burst_keeps_order_counts_gaps_and_bad_frames(zmq_url: str, name: str,
+                                                         ctx: zmq.Context[zmq.Socket[bytes]]
+                                                         ) -> None:
+    """A burst larger than one wake-up's batch (the feed reads and decodes a batch, then
+    hands it out): malformed frames, a mark and skipped sequence numbers in the middle;
+    both subscriptions get every good message once, in order, and every bad frame and gap
+    is counted."""
+    burst, skipped, bad = 3 * BATCH, {100, 101, 500}, {50, 300, 700}
+    with robosoa.connect(zmq_url, **FAST) as bus:
+        called: list[robosoa.Message] = []
+        bus.subscribe(name, called.append)
+        iterated = bus.subscribe(name)
+        pub = raw_publisher(ctx, bus, f"burst-{name}")
+        channel = f"t:{name}\0".encode()
+        try:
+            def probe() -> robosoa.Message | None:
+                pub.send(_broadcast(channel, 1, b'{"kind":"publish","payload":{"n":0}}'))
+                return iterated.get(timeout=0.05)
+
+            eventually(probe)  # the subscriber has found and joined the raw PUB
+            eventually(lambda: called)
+            sent = []
+            for seq in range(2, burst + 2):
+                if seq in skipped:
+                    continue
+                if seq == 400:  # a mark: "my last number here is 399", and a frame too short
+                    pub.send(_broadcast(channel, seq - 1, b"", MARK))
+                    pub.send(channel + b"short")
+                if seq in bad:
+                    pub.send(_broadcast(channel, seq, b'{"kind":"publish","payload":'))
+                else:
+                    body = {"kind": "publish", "payload": {"n": seq}}
+                    pub.send(_broadcast(channel, seq, json.dumps(body).encode()))
+                    sent.append(seq)
+            got = [msg.payload["n"] for msg in iter(lambda: iterated.get(timeout=2.0), None)]
+            assert got == sent
+            eventually(lambda: len(called) == len(sent) + 1)
+            assert [msg.payload["n"] for msg in called[1:]] == sent
+            figures = {(f.role, f.key): f for f in bus.stats()}
+            assert figures[("wire", "broadcast")].errors == len(bad) + 1
+            assert dict(figures[("subscriber", name)].drops) == {"lost": len(skipped)}
         finally:
             pub.close(0)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from hypothesis import given, settings
@@ -10,7 +11,7 @@ from hypothesis import strategies as st
 
 from robosoa.errors import InvalidMessage
 from robosoa.message import decode
-from robosoa.wire import MAX_DEPTH, LimitExceeded, depth, load_json, load_object
+from robosoa.wire import MAX_DEPTH, LimitExceeded, depth, load_json, load_object, long_number
 
 
 def nested(levels: int, inner: str = "1") -> bytes:
@@ -119,3 +120,19 @@ def test_the_fast_reading_refuses_what_json_refuses(raw: bytes) -> None:
 def test_where_orjson_and_json_differ_json_decides(raw: bytes) -> None:
     fast, standard = _both(raw)
     assert fast == standard
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(st.sampled_from([b"0", b"7", b"9", b"12345678", b"1234567890", b"/", b":",
+                                 b".", b"-", b"e", b"\xb9", b"\x00", b'"']), max_size=40)
+       .map(b"".join))
+def test_long_number_finds_what_the_regular_expression_finds(raw: bytes) -> None:
+    """The spec is ``re`` ``[0-9]{19}``; the ASCII neighbours of the digits ("/" and ":")
+    and a superscript digit byte must not count."""
+    assert long_number(raw) == bool(re.search(rb"[0-9]{19}", raw))
+
+
+def test_long_number_on_the_edges() -> None:
+    assert long_number(b'{"a":' + b"1" * 19 + b"}")
+    assert not long_number(b'{"a":' + b"1" * 18 + b".5}")
+    assert long_number(b"0.1234567890123456789")  # a long fraction: json reads it (same value)
