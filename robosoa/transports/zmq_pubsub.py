@@ -307,10 +307,15 @@ class Feed:
 
 
 def _hand_out(batch: list[Offer]) -> None:
-    """Give every message of ``batch`` to its best-effort sinks, in order; empty it."""
+    """Give every message of ``batch`` to its best-effort sinks, in order; empty it. A
+    sink that fails loses that message only, as a message that failed alone did before
+    batches (never let one message end the subscriber thread)."""
     for sinks, msg, size, expires in batch:
-        for sink in sinks:
-            sink(msg, size, expires, False)
+        try:
+            for sink in sinks:
+                sink(msg, size, expires, False)
+        except Exception:
+            log.exception("broadcast delivery failed")
     batch.clear()
 
 

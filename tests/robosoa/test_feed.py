@@ -100,6 +100,24 @@ def test_large_messages_are_handed_out_one_by_one(
     assert reads == list(range(reads[0], reads[0] + 5))  # each before the next is read
 
 
+def test_a_sink_that_fails_loses_that_message_only(
+        wired: tuple[Feed, zmq.Socket[bytes], CountingSocket]) -> None:
+    """A sink raising on one message of a batch: that message is lost (to the sinks after
+    it too), the batch's later messages are handed out in order and the drain returns (as
+    when messages were handed out alone)."""
+    feed, _, _ = wired
+
+    def failing(msg: Message, size: int, expires: float, hold: bool) -> bool:
+        if msg.payload["n"] == 3:
+            raise RuntimeError("a sink's own bug")
+        return True
+
+    feed.subscribe("t:scan", failing)
+    handed = _drained(wired, 100, 6)  # its recording sink comes after the failing one
+    assert [n for n, _ in handed] == [1, 2, 4, 5, 6]
+    assert len({reads for _, reads in handed}) == 1  # still one batch
+
+
 def test_recv_message_takes_whole_messages_and_cuts_off_extra_frames() -> None:
     """One-frame messages, messages of several frames and one of more frames than allowed
     come off the socket whole, in order; the frames past the limit are read and thrown
