@@ -9,18 +9,9 @@ from pathlib import Path
 from archmetrics.app.coupling import packs_digest
 from archmetrics.coupling import load_rule_packs
 from archmetrics.coupling.rules import RuleSet
+from tests.coupling.test_rule_packs import GOOD_RULE
 
-PACK = """[pack]
-name = "custom"
-
-[[rules]]
-id = "ping"
-language = "python"
-match = ["*.ping"]
-kind = "messaging"
-role = "initiate"
-endpoint = { type = "service", arg = 0 }
-"""
+PACK = '[pack]\nname = "custom"\n' + GOOD_RULE
 
 
 def _digest(path: Path, text: str) -> str:
