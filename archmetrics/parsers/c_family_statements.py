@@ -142,13 +142,10 @@ def _fixed_text(node: Node, start: int, end: int, clean: bytes) -> str | None:
 
 
 def _bounds(node: Node, rule: StatementRule, templates: Mapping[int, tuple[int, int]]) -> _Extent:
-    """Bytes and rows of the statement's own part; a template starts at its `template`."""
-    if rule.shape is Shape.WHOLE:  # the common case, kept cheap
-        end_point = node.end_point
-        last = end_point.row if end_point.column else end_point.row - 1
-        bounds = (node.start_byte, node.end_byte, node.start_point.row, last, "", "")
-    else:
-        bounds = _extent(node, rule)
+    """Bytes and rows of the statement's own part; a template starts at its `template`.
+    (Statements of the whole-node shape are bounded inline by ``statements``, the hot loop;
+    this takes the other shapes.)"""
+    bounds = _extent(node, rule)
     if bounds[0] in templates:
         start, first = templates[bounds[0]]
         return start, bounds[1], first, bounds[3], bounds[4], bounds[5]
