@@ -124,14 +124,16 @@ class PlainElements:
         return len(self.names)
 
     def change(self, name: str) -> ElementChange:
-        """The change set :func:`unchanged_change` makes of the element."""
-        row, found = self.rows[name], self.values[name]
-        post = _new(Metrics, row[3:] + tuple(found))
-        pre = _new(Metrics, (*row[3:], found[0], found[1], 0, 0)) if self.dynamic_pre_zero else post
-        return _new(ElementChange, (name, row[1], row[0], _UNCHANGED, pre, post, 0, 0, 0, ()))
+        """The element's change set, as :func:`unchanged_change` makes it (its values are
+        measured on both sides: no notes)."""
+        return unchanged_change(name, self.rows[name], self._sides(), [])
 
     def changes(self) -> Iterator[ElementChange]:
-        return map(self.change, self.names)
+        sides, rows = self._sides(), self.rows
+        return (unchanged_change(name, rows[name], sides, []) for name in self.names)
+
+    def _sides(self) -> tuple[Side, Side]:
+        return Side("pre", self.values, self.dynamic_pre_zero), Side("post", self.values)
 
     def sums(self) -> dict[Location, tuple[Metrics, Metrics]]:
         """Σ of the elements' metrics before and after, per location (integers: the same
