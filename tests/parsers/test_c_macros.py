@@ -191,7 +191,10 @@ def test_a_macro_run_that_leaves_a_comment_is_left_alone() -> None:
 
 def test_a_listed_attribute_macro_need_not_be_in_capitals() -> None:
     facts = facts_of("class my_export Proxy : Base { int f() { return 1; } };\n", "cpp")
-    assert "Proxy::f" not in complexities(facts)  # not recognised without the list
+    # not recognised without the list: tree-sitter misreads the class, the token reading
+    # finds the method (estimated, with a warning)
+    assert [(f.qualified_name, f.estimated) for f in facts.functions] == [("Proxy::f", True)]
+    assert len(facts.warnings) == 1
     source = b"class my_export Proxy : Base { int f() { return 1; } };\n"
     blanked = blank_macros(source, names=MacroNames(attribute=("my_export",)), first=True)
     assert blanked.startswith(b"class           Proxy")
@@ -705,13 +708,20 @@ def test_a_catch_clause_behind_an_ifdef_counts() -> None:
 def test_errors_and_missing_tokens_are_what_the_query_captures(source: str) -> None:
     from tree_sitter import QueryCursor
 
-    from archmetrics.parsers.c_family_grammar import errors_and_missing, grammar
+    from archmetrics.parsers.c_family_grammar import errors_and_missing, grammar, stray_directive
 
+    data = source.encode()
     for language in ("c", "cpp"):
         built = grammar(language)
-        root = built.parser.parse(source.encode()).root_node
+        root = built.parser.parse(data).root_node
         captured = QueryCursor(built.query).captures(root)
-        found = errors_and_missing(root)
+        strays = [  # an #else of a group closed early is damage too (c_family.py)
+            n
+            for n in captured.get("stmt", [])
+            if n.type == "preproc_call" and stray_directive(n, data)
+        ]
+        captured["error"] = captured.get("error", []) + strays
+        found = errors_and_missing(root, data)
         for name in ("error", "missing"):
             assert sorted((n.start_byte, n.end_byte, n.type) for n in found[name]) == sorted(
                 (n.start_byte, n.end_byte, n.type) for n in captured.get(name, [])
