@@ -30,7 +30,7 @@ Token = tuple[str, bytes, int]
 _TOKENS = re.compile(
     rb"(?P<s>//(?:\\\r?\n|[^\n])*+|/\*(?:[^*]|\*(?!/))*+(?:\*/|\Z)|\\\r?\n)"
     rb'|(?P<q>(?:u8|[uUL])?R"(?P<d>[^()\\\s"]{0,16})\((?:[^)]|\)(?!(?P=d)"))*+(?:\)(?P=d)"|\Z)'
-    rb"|(?:u8|[uUL])?\"(?:\\.|[^\"\\\n])*+\"?|(?<![\w'])'(?:\\.|[^'\\\n])*+'?)"
+    rb"|(?:u8|[uUL])?\"(?:\\.|[^\"\\\n])*+\"?|(?:u8|[uUL])?'(?:\\.|[^'\\\n])*+'?)"
     rb"|(?P<p>^[ \t]*+\#(?:[^\n\\/]++|\\.|/\*(?:[^*]|\*(?!/))*+(?:\*/|\Z)|/)*+)"
     rb"|(?P<w>[A-Za-z_$][\w$]*+)"
     rb"|(?P<n>\.?\d(?:[eEpP][-+]|['\w.])*+)"
@@ -89,7 +89,7 @@ class TokenReading:
     statements: list[int]
     calls: list[int]
     defines_in_blocks: list[int]  # `#define` lines inside an initializer or other block
-    unclosed: list[int]  # where a function or block begins whose braces never close
+    unclosed: list[int]  # where a function or head begins whose brackets never close
 
 
 @dataclass(slots=True)
@@ -151,6 +151,8 @@ class _Reader:
                 self._at_scope(index, kind, text)
         state = self.state
         unclosed = [state.function.start] if state.function is not None else []
+        if state.head and (state.parens or state.depth):  # a head left open: `f( {`
+            unclosed.append(self.toks[state.head[0]][2])
         return TokenReading(
             sorted(self.found, key=lambda f: f.start),
             self.statements,
@@ -284,7 +286,7 @@ class _Reader:
             )  # after a K&R head's earlier declarations
             if begins < len(head):
                 self.statements.append(self.toks[head[begins]][2])
-        if state.kr or opens_kr(self.toks, state.head):
+        if state.kr or (len(state.scopes) == 1 and opens_kr(self.toks, state.head)):
             state.kr = True
             state.head.append(index)
             return

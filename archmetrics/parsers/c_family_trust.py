@@ -28,7 +28,12 @@ from archmetrics.parsers.c_family_functions import FunctionSlot
 from archmetrics.parsers.c_family_heads import KEYWORDS
 from archmetrics.parsers.c_family_tokens import TokenFunction, TokenReading
 
-_DEFINE = re.compile(rb"(?m)^[ \t]*+\#[ \t]*+define[ \t]++(\w++)(\([^)\n]*+\))?+([^\n]*+)")
+_DEFINE = re.compile(
+    rb"(?m)^[ \t]*+\#[ \t]*+define[ \t]++(\w++)(\([^)\n]*+\))?+((?:\\\n|[^\n])*+)"
+)
+
+
+_PARENTHESES = re.compile(rb"\([^()]*+\)")
 
 
 class Lines:
@@ -79,8 +84,11 @@ def _macro_names(data: bytes) -> frozenset[str]:
     a function named after one of them is none."""
     names = set()
     for found in _DEFINE.finditer(data):
-        body = found.group(3).rstrip(b" \t\\")
-        head_like = body.endswith((b")", b"const")) and not any(c in body for c in b"{};,=")
+        body = found.group(3).replace(b"\\\n", b" ").rstrip(b" \t\\")
+        outside = _PARENTHESES.sub(b"", body)
+        while outside != (inner := _PARENTHESES.sub(b"", outside)):
+            outside = inner  # the parameter lists' commas are no declaration's
+        head_like = body.endswith((b")", b"const")) and not any(c in outside for c in b"{};,=")
         if not head_like:
             names.add(found.group(1).decode("utf-8", "replace"))
     return frozenset(names)
@@ -168,7 +176,7 @@ def reconcile(
             kept.append(slot)
         elif at in matched and not keyword:
             token = functions[matched[at]]
-            if token.name != slot.name and area is not None:  # a head the tree misread
+            if area is not None and not slot.name.startswith(token.name):  # a misread head
                 area.renamed.append((slot.qualified, token.qualified))
                 slot.name, slot.qualified = token.name, token.qualified
                 slot.span = Span(min(lines.of(token.start), slot.span.end), slot.span.end)

@@ -81,7 +81,7 @@ def _losses(area: Area, reading: TokenReading, counted: Counted, lines: Lines) -
         parts.append(f"the head of {name} read as {tree!r}")
     unclosed = [at for at in reading.unclosed if area.start <= at < area.end]
     if unclosed:
-        parts.append(f"the braces from line {lines.of(unclosed[0])} on never close")
+        parts.append(f"the brackets from line {lines.of(unclosed[0])} on never close")
     if area.unmeasured:
         parts.append(f"{_plural(area.unmeasured, 'function')} not measured")
     again = {slot.qualified for slot in area.added}

@@ -287,7 +287,7 @@ def test_unparseable_cpp_still_measures_the_rest() -> None:
     facts = cpp(source)
     assert facts.parsed
     assert [w.message for w in facts.warnings] == [
-        "lines 2-3: the braces from line 2 on never close (a statement read as a function"
+        "lines 2-3: the brackets from line 2 on never close (a statement read as a function"
         " definition (a macro call without its ';'?))"
     ]
     assert "ok" in complexities(facts)
