@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
-from typing import TypeVar
+from typing import NamedTuple, TypeVar
 
 from archmetrics.app.collect import parse_all, select, worker_limits
 from archmetrics.app.coupling import (
@@ -36,6 +36,7 @@ from archmetrics.changeset.statement_diff import (
     same_statements,
 )
 from archmetrics.changeset.unchanged import Unchanged
+from archmetrics.complexity import Reading
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, group_elements
 from archmetrics.coupling.rules import RuleSet
@@ -260,6 +261,26 @@ def change_key(
     return f"{CHANGE_RECORD}:{_digest(document)}"
 
 
+class Measured(NamedTuple):
+    """A diff's measure: the change, the parse warnings of both sides, and how much of the
+    two sides' files was read in full."""
+
+    change: ChangeReport
+    warnings: tuple[ParseWarning, ...]
+    reading: Reading
+
+
+def reading_of(*sides: Sequence[FileRow], rules: LocationRules | None = None) -> Reading:
+    """How much of the files of each side was read in full (files an exclude glob of
+    ``rules`` leaves out are not counted); a file both sides hold alike counts once."""
+    seen: dict[tuple[str, str], FileRow] = {}
+    for side in sides:
+        for row in side:
+            if rules is None or not rules.is_excluded(row.path):
+                seen.setdefault((row.path, row.blob), row)
+    return Reading.of((bool(row.warnings), row.functions, row.estimated) for row in seen.values())
+
+
 def parse_warnings(
     *sides: Sequence[FileFacts | FileRow], rules: LocationRules | None = None
 ) -> tuple[ParseWarning, ...]:
@@ -296,8 +317,9 @@ def measure_change(
     cache: FactsCache | None = None,
     checkout: Checkout | None = None,
     options: DiffOptions | None = None,
-) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
-    """The change report between the two snapshots, and the parse warnings of both sides.
+) -> Measured:
+    """The change report between the two snapshots, the parse warnings of both sides, and
+    how much of them was read in full.
     ``checkout``: the repository, opened once by the caller (else opened here); ``options``:
     the request's options, merged once by the caller (else here). Every step is named on
     ``progress``: reading each side, parsing, coupling each tree, comparing the files."""
@@ -320,7 +342,7 @@ def measure_snapshots(
     renames: Mapping[str, str] | Callable[[], Mapping[str, str]],
     progress: Progress | None = None,
     cache: FactsCache | None = None,
-) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
+) -> Measured:
     """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
     path, or how to ask for them when the head's state was not patched from the base's),
     under ``options``. Each side's state comes from app/tree.py: kept, patched or built."""
@@ -341,7 +363,11 @@ def measure_snapshots(
     progress.phase("comparing the changed files")
     change = _compare(pre, post, moved, options, progress, cache)
     progress.stop()
-    return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
+    return Measured(
+        change,
+        parse_warnings(pre.state.rows, post.state.rows, rules=options.rules),
+        reading_of(pre.state.rows, post.state.rows, rules=options.rules),
+    )
 
 
 def _compare(
@@ -436,8 +462,8 @@ def run_diff(
     :func:`measure_change` (a series opens and merges once for all its stages)."""
     checkout = checkout or open_checkout(request.root)
     options = options or diff_options(request, checkout.root)  # a bad gate fails before work
-    change, warnings = measure_change(request, progress, cache, checkout, options)
+    change, warnings, reading = measure_change(request, progress, cache, checkout, options)
     gates = options.gates
     report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
     failures = check_gates(gates, report.summaries())
-    return DiffReport(report.base, report.head, change, warnings, report.gates, failures)
+    return DiffReport(report.base, report.head, change, warnings, report.gates, failures, reading)

@@ -10,7 +10,7 @@ from typing import Any
 
 from archmetrics.changeset.accuracy import Accuracy
 from archmetrics.changeset.model import ChangeReport
-from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity import FileMetrics, Reading, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
 from archmetrics.reports.model import (
@@ -53,6 +53,7 @@ def _file(metrics: FileMetrics) -> dict[str, Any]:
                 "end_line": f.end_line,
                 "loc": f.loc,
                 "vg": f.vg,
+                "estimated": f.estimated,
             }
             for f in metrics.functions
         ],
@@ -69,6 +70,8 @@ def totals_dict(totals: Totals) -> dict[str, Any]:
         "vg": totals.vg,
         "warnings": totals.warnings,
         "unparsed": totals.unparsed,
+        "files_warned": totals.files_warned,
+        "functions_estimated": totals.functions_estimated,
     }
 
 
@@ -166,6 +169,16 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
         "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+        **({} if report.reading is None else {"reading": reading_dict(report.reading)}),
+    }
+
+
+def reading_dict(reading: Reading) -> dict[str, Any]:
+    return {
+        "files": reading.files,
+        "files_warned": reading.files_warned,
+        "functions": reading.functions,
+        "functions_estimated": reading.functions_estimated,
     }
 
 

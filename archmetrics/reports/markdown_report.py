@@ -61,7 +61,9 @@ def render_scan(report: ScanReport, grouping: str) -> str:
     ]
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     if warnings:
-        parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
+        parts.append(
+            f"\n**Warnings**: {t.reading().line()}\n\n" + "".join(f"- `{w}`\n" for w in warnings)
+        )
     if report.excluded:
         parts.append("".join(f"- excluded `{x.path}`: {x.reason}\n" for x in report.excluded))
     if report.gates:
@@ -136,6 +138,8 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
         more = len(excluded) - _SHOWN_EXCLUDED
         bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
+    if report.reading is not None and report.warnings:
+        bullets.append(f"- {report.reading.line()}")
     tail = ["\n".join(bullets) + "\n"] if bullets else []
     changed = report.change.changed()
     if changed:

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from archmetrics.changeset.accuracy import ChangeAccuracy
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
-from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity import FileMetrics, Reading, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.coupling import CouplingReport
 from archmetrics.facts import FileFacts, ParseWarning
@@ -80,6 +80,7 @@ class DiffReport:
     warnings: tuple[ParseWarning, ...] = ()
     gates: tuple[str, ...] = ()  # the gate expressions checked
     failures: tuple[GateFailure, ...] = ()
+    reading: Reading | None = None  # how much of both sides was read in full
 
     def summaries(self) -> dict[str, Summary]:
         """Per location and the total, keyed base, new, framework, total."""

@@ -125,7 +125,8 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     else:
         table = _file_table(report)
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
-    extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
+    reading = report.totals.reading().line()
+    extra = ["", f"warnings ({reading}):", *("  " + w for w in warnings)] if warnings else []
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
     extra += gate_lines(report)
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
@@ -157,6 +158,8 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
+    if report.reading is not None and report.warnings:
+        lines.append(report.reading.line())
     lines += [str(f) for f in report.failures]
     return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
 
