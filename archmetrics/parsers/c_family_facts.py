@@ -67,7 +67,9 @@ def facts(
     )
     slots, nested = function_slots(made, data, scopes)
     suspects = suspect_regions(found, data, slots, nested, made, explained)
-    trust = _Trust.of(slots, suspects, data, language) if suspects and second_reading else None
+    trust = None
+    if suspects and second_reading:
+        trust = _Trust.of(slots, suspects, data, language, scopes)
     if trust is not None:
         slots = trust.slots
     owner = Owners(slots)
@@ -141,9 +143,17 @@ class _Trust:
         suspects: list[tuple[int, int, str]],
         data: bytes,
         language: Language,
+        scopes: Scopes,
     ) -> _Trust:
         lines = Lines(data)
-        reading = c_family_tokens.read(data, language == Language.CPP)
+        spans = windows(suspects, slots, len(data))
+        reading = c_family_tokens.read(data, language == Language.CPP, spans)
+        starts = [start for start, _ in spans]
+        for function in reading.functions:  # the scopes around its window, from the tree
+            at = spans[bisect.bisect_right(starts, function.start) - 1][0]
+            outer = scopes.prefix_at(at)
+            if outer:
+                function.qualified = f"{outer}::{function.qualified}"
         kept, areas, pairs = reconcile(slots, reading, areas_of(suspects), data, lines)
         regions = [(start, end) for start, end, _ in suspects]
         return cls(kept, areas, regions, pairs, reading, lines)
@@ -153,6 +163,31 @@ class _Trust:
 
     def warnings(self, path: str, data: bytes, counted: Counted) -> tuple[ParseWarning, ...]:
         return warnings(path, self.areas, self.reading, data, counted, self.lines)
+
+
+def windows(
+    suspects: list[tuple[int, int, str]], slots: list[FunctionSlot], size: int
+) -> list[tuple[int, int]]:
+    """The byte ranges the token reading reads: around each suspect region, from the end
+    of the last function of the tree before it (where the tree stands between
+    declarations) to the end of the first function after every function that overlaps it
+    (a function the region swallowed may end far after it), joined where they meet."""
+    ends = [slot.end for slot in slots]
+    starts = [slot.start for slot in slots]
+    found: list[tuple[int, int]] = []
+    for start, end, _ in sorted(suspects):
+        before = bisect.bisect_right(ends, start) - 1
+        begin = ends[before] if before >= 0 else 0
+        index = bisect.bisect_left(ends, start + 1)  # the first slot ending after the start
+        while index < len(slots) and starts[index] < end:
+            end = max(end, ends[index])
+            index += 1
+        stop = ends[index] if index < len(slots) else size
+        if found and begin <= found[-1][1]:
+            found[-1] = (found[-1][0], max(found[-1][1], stop))
+        else:
+            found.append((begin, stop))
+    return found
 
 
 def suspect_regions(

@@ -129,6 +129,11 @@ class Scopes:
         return found
 
 
+    def prefix_at(self, offset: int) -> str:
+        """The qualified name of the named scopes around byte ``offset`` ("" if none)."""
+        return _tail("::".join(name for start, end, name in self._named if start < offset < end))
+
+
 def _tail(qualified: str) -> str:
     if len(qualified) <= shown.LIMIT:
         return qualified

@@ -56,11 +56,12 @@ _NOT_CALLED = frozenset(
 )  # fmt: skip
 
 
-def tokens(data: bytes) -> list[Token]:
-    """The tokens of ``data`` that the reading needs: comments and numbers dropped."""
+def tokens(data: bytes, start: int = 0, end: int | None = None) -> list[Token]:
+    """The tokens of ``data[start:end]`` that the reading needs: comments and numbers
+    dropped."""
     return [
         (kind, found.group(), found.start())
-        for found in _TOKENS.finditer(data)
+        for found in _TOKENS.finditer(data, start, len(data) if end is None else end)
         if (kind := found.lastgroup or "s") not in ("s", "n")
     ]
 
@@ -332,6 +333,31 @@ class _Reader:
                 self.state = first
 
 
-def read(data: bytes, cpp: bool) -> TokenReading:
-    """The token reading of a whole file (``cpp``: C++'s `catch`, `and`, `or` count)."""
-    return _Reader(tokens(data), cpp).read()
+def read(
+    data: bytes, cpp: bool, windows: list[tuple[int, int]] | None = None
+) -> TokenReading:
+    """The token reading of ``data``, or of each of ``windows`` (sorted, disjoint byte
+    ranges that start where the syntax tree stands between declarations). ``cpp``: C++'s
+    `catch`, `and`, `or` count. A window whose reading ends inside a body or a head is read
+    again to the end of the file: its end was no boundary for the tokens."""
+    size = len(data)
+    spans = windows if windows is not None else [(0, size)]
+    readings: list[TokenReading] = []
+    reached = 0
+    for start, end in spans:
+        start = max(start, reached)
+        if start >= end:
+            continue
+        reading = _Reader(tokens(data, start, end), cpp).read()
+        if reading.unclosed and end < size:
+            end = size
+            reading = _Reader(tokens(data, start, end), cpp).read()
+        reached = end
+        readings.append(reading)
+    return TokenReading(
+        [f for r in readings for f in r.functions],
+        [at for r in readings for at in r.statements],
+        [at for r in readings for at in r.calls],
+        [at for r in readings for at in r.defines_in_blocks],
+        [at for r in readings for at in r.unclosed],
+    )
