@@ -1,0 +1,304 @@
+"""Functions no reader of the source would name: ours (made up) and lizard's (its inventions).
+
+Shared by benchmarks/made_up_functions.py and benchmarks/oracle_c.py. Independent of the
+parser's own checks (archmetrics/parsers/c_family_trust.py): the keyword list, the macro
+definitions and the spans are read here again, from the source and from lizard.
+
+A function of ours is made up when
+  * its name is a C or C++ keyword (``namespace``, ``if``, ``struct``);
+  * its head is a call of a macro the file defines whose body is no function head
+    (``OP(mtx) {`` after ``#define OP(m) {NAME(#m), CHILD(m)},``; a macro that ends in a
+    declarator, ``#define TEST_BEGIN(f) static void f(void)``, makes real functions named
+    after it, as lizard and the test frameworks name them; a function declared with a
+    type may share its name with a macro of another #if branch);
+  * its span covers the start of a function lizard reports that is not a method of a class
+    defined inside it (a head tree-sitter lost, swallowed with its body).
+
+A function of lizard's is its invention (left out of "lizard's real functions") when
+  * its name is a keyword (``if (l_likely(L)) {`` read as a function named ``if``);
+  * it spans the starts of two or more of lizard's or our functions (a macro that made it
+    lose its way: it reads on to some later ``}``);
+  * it lies inside a multi-line ``#define`` (lizard reads a macro's body as code; the
+    function exists only where the macro is used);
+  * it is a method of a class defined inside one of our functions (our rule, and lizard's
+    own when it sees the function around it: docs/metrics.md, v_g).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+KEYWORDS = frozenset(
+    [
+        "alignas",
+        "alignof",
+        "and",
+        "and_eq",
+        "asm",
+        "auto",
+        "bitand",
+        "bitor",
+        "bool",
+        "break",
+        "case",
+        "catch",
+        "char",
+        "char8_t",
+        "char16_t",
+        "char32_t",
+        "class",
+        "compl",
+        "concept",
+        "const",
+        "consteval",
+        "constexpr",
+        "constinit",
+        "const_cast",
+        "continue",
+        "co_await",
+        "co_return",
+        "co_yield",
+        "decltype",
+        "default",
+        "delete",
+        "do",
+        "double",
+        "dynamic_cast",
+        "else",
+        "enum",
+        "explicit",
+        "export",
+        "extern",
+        "false",
+        "float",
+        "for",
+        "friend",
+        "goto",
+        "if",
+        "inline",
+        "int",
+        "long",
+        "mutable",
+        "namespace",
+        "new",
+        "noexcept",
+        "not",
+        "not_eq",
+        "nullptr",
+        "or",
+        "or_eq",
+        "private",
+        "protected",
+        "public",
+        "register",
+        "reinterpret_cast",
+        "requires",
+        "restrict",
+        "return",
+        "short",
+        "signed",
+        "sizeof",
+        "static",
+        "static_assert",
+        "static_cast",
+        "struct",
+        "switch",
+        "template",
+        "this",
+        "thread_local",
+        "throw",
+        "true",
+        "try",
+        "typedef",
+        "typeid",
+        "typename",
+        "union",
+        "unsigned",
+        "using",
+        "virtual",
+        "void",
+        "volatile",
+        "wchar_t",
+        "while",
+        "xor",
+        "xor_eq",
+        "_Alignas",
+        "_Alignof",
+        "_Atomic",
+        "_Bool",
+        "_Generic",
+        "_Noreturn",
+        "_Static_assert",
+        "_Thread_local",
+    ]
+)
+_DEFINE = re.compile(r"^[ \t]*#[ \t]*define[ \t]+(\w+)(\([^)\n]*\))?((?:\\\n|[^\n])*)", re.M)
+
+
+def keyword(name: str) -> bool:
+    """Whether a function's (last) name is a keyword; `operator ...` and `~X` are not."""
+    last = name.rsplit("::", 1)[-1].strip()
+    return last in KEYWORDS
+
+
+def macro_names(source: str) -> frozenset[str]:
+    """The macros ``source`` defines whose body is no function head."""
+    names = set()
+    for found in _DEFINE.finditer(source):
+        body = found.group(3).replace("\\\n", " ").rstrip(" \t\\")
+        outside = body
+        while True:  # the parameter lists' commas are no declaration's
+            inner = re.sub(r"\([^()]*\)", "", outside)
+            if inner == outside:
+                break
+            outside = inner
+        if not (body.endswith((")", "const")) and not any(c in outside for c in "{};,=")):
+            names.add(found.group(1))
+    return frozenset(names)
+
+
+def define_lines(source: str) -> set[int]:
+    """The lines (1-based) of multi-line ``#define``s after their first."""
+    inside: set[int] = set()
+    continued = False
+    for number, line in enumerate(source.splitlines(), 1):
+        if continued:
+            inside.add(number)
+        stripped = line.rstrip()
+        starts = re.match(r"[ \t]*#[ \t]*define\b", line) is not None
+        continued = stripped.endswith("\\") and (starts or continued)
+    return inside
+
+
+@dataclass(frozen=True, slots=True)
+class Ours:
+    name: str
+    start: int
+    end: int
+    vg: int
+    estimated: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Theirs:
+    name: str
+    start: int
+    end: int
+    vg: int
+
+
+def made_up(
+    ours: list[Ours],
+    theirs: list[Theirs],
+    macros: frozenset[str],
+    local_classes: list[tuple[int, int]],
+    lines: list[str],
+) -> list[tuple[Ours, str]]:
+    """Each of ``ours`` that is made up, with why; ``local_classes``: the spans of classes
+    defined inside our functions; ``lines``: the source's."""
+    found: list[tuple[Ours, str]] = []
+    for function in ours:
+        last = function.name.rsplit("::", 1)[-1]
+        if keyword(function.name):
+            found.append((function, "keyword"))
+        elif last in macros and _called(lines, function, last):
+            found.append((function, "a macro the file defines"))
+        else:
+            covered = [
+                other
+                for other in theirs
+                if function.start < other.start <= function.end
+                and other.end < function.end
+                and not any(s <= other.start and other.end <= e for s, e in local_classes)
+                and not keyword(other.name)
+            ]
+            if covered:
+                found.append((function, f"covers {covered[0].name} at {covered[0].start}"))
+    return found
+
+
+def _called(lines: list[str], function: Ours, name: str) -> bool:
+    """Whether ``function``'s head is a call of ``name`` (``OP(mtx) {``): no type before it,
+    as in a real function that shares a macro's name in another #if branch (``static void
+    LUAI_TRY (lua_State *L, ...) {`` beside ``#define LUAI_TRY(L,c,f,ud) ...``)."""
+    head = " ".join(lines[function.start - 1 : function.end]).split("(", 1)[0]
+    return head.strip() == name
+
+
+def invention(
+    other: Theirs,
+    theirs: list[Theirs],
+    ours: list[Ours],
+    defines: set[int],
+    local_classes: list[tuple[int, int]],
+) -> str | None:
+    """The class of lizard's invention ``other`` is, or None for a real function."""
+    if keyword(other.name):
+        return "keyword"
+    if other.start in defines:
+        return "inside a #define"
+    inner = {f.start for f in theirs if other.start < f.start and f.end <= other.end}
+    inner |= {f.start for f in ours if other.start < f.start and f.end <= other.end}
+    if len(inner) >= 2:
+        return "spans other functions"
+    if any(s <= other.start and other.end <= e for s, e in local_classes):
+        return "method of a class inside a function"
+    return None
+
+
+_KEYWORDS_NOT_CALLED = KEYWORDS | {"defined", "__attribute__", "__declspec", "typeof"}
+_HEADERS = frozenset({"if", "for", "switch", "case", "default", "catch", "while"})
+_DIRECTIVE_STATEMENTS = re.compile(r"#\s*(?:define|include|undef|pragma|error|line|import)\b")
+
+
+def recount(source: str, first: int, last: int) -> tuple[int, int]:
+    """(statements, calls) that begin or end on lines ``first``..``last``, counted again
+    on lizard's tokens, independently of the parser: a statement per `;` outside
+    parentheses, per statement keyword (``if``, ``case``...; a do-while's ``while`` aside)
+    and per counted directive (``#define``, ``#include``...); a call per word before a
+    `(` that is no keyword, has no word before it (a declaration ``T x(1)``) and heads no
+    block (``FOR_EACH(x) {``)."""
+    from lizard_languages.clike import CLikeReader
+
+    tokens: list[tuple[str, int]] = []
+    line = 1
+    for token in CLikeReader.generate_tokens(source):
+        if not token.isspace() and not token.startswith(("//", "/*")):
+            tokens.append((token, line))
+        line += token.count("\n")
+    statements = calls = depth = 0
+    for index, (token, at) in enumerate(tokens):
+        depth += (token == "(") - (token == ")")
+        if not first <= at <= last:
+            continue
+        before = tokens[index - 1][0] if index else ""
+        if _statement(token, before, depth):
+            statements += 1
+        elif _a_call(tokens, index, before):
+            calls += 1
+    return statements, calls
+
+
+def _statement(token: str, before: str, depth: int) -> bool:
+    if token == ";":
+        return depth <= 0
+    if token in _HEADERS:
+        return not (token == "while" and before == "}")
+    return token.startswith("#") and _DIRECTIVE_STATEMENTS.match(token) is not None
+
+
+def _a_call(tokens: list[tuple[str, int]], index: int, before: str) -> bool:
+    token = tokens[index][0]
+    if not (token[:1].isalpha() or token[:1] == "_") or token in _KEYWORDS_NOT_CALLED:
+        return False
+    if index + 1 >= len(tokens) or tokens[index + 1][0] != "(":
+        return False
+    if (before[:1].isalnum() or before[:1] == "_") and before not in ("return", "case", "else"):
+        return False
+    depth = 0
+    for after in range(index + 1, min(len(tokens), index + 400)):
+        depth += (tokens[after][0] == "(") - (tokens[after][0] == ")")
+        if depth == 0:
+            return after + 1 >= len(tokens) or tokens[after + 1][0] != "{"
+    return True
