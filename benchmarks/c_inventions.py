@@ -143,17 +143,19 @@ def keyword(name: str) -> bool:
 
 
 def macro_names(source: str) -> frozenset[str]:
-    """The macros ``source`` defines whose body is no function head."""
+    """The macros ``source`` defines whose body does not end in a function head after its
+    last `;` or `}` (a test macro may define a class, then its method's head)."""
     names = set()
     for found in _DEFINE.finditer(source):
         body = found.group(3).replace("\\\n", " ").rstrip(" \t\\")
-        outside = body
-        while True:  # the parameter lists' commas are no declaration's
+        last = body[max(body.rfind(";"), body.rfind("}")) + 1 :]
+        outside = last
+        while True:  # a default argument's `=` is no initializer's
             inner = re.sub(r"\([^()]*\)", "", outside)
             if inner == outside:
                 break
             outside = inner
-        if not (body.endswith((")", "const")) and not any(c in outside for c in "{};,=")):
+        if not (last.rstrip().endswith((")", "const")) and "=" not in outside):
             names.add(found.group(1))
     return frozenset(names)
 

@@ -363,7 +363,7 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
             break
     if not choices:
         return None
-    return _merge(reading, readings, choices, found_in)
+    return _merge(reading, readings, choices, found_in, [layout.set_aside for layout in layouts])
 
 
 def _covered(base: Layout, choices: list[Choice]) -> bool:
@@ -465,8 +465,11 @@ def _merge(
     readings: list[Reading],
     choices: list[Choice],
     directives: list[list[tuple[int, str, int]]],
+    set_aside: list[list[tuple[int, int]]],
 ) -> Composite:
-    """``base``'s captures outside the chosen regions, the chosen readings' inside."""
+    """``base``'s captures outside the chosen regions, the chosen readings' inside, and the
+    #if branches a chosen reading set aside there (they are read from tokens: a function
+    there is reported, estimated, under a warning; c_family_trust.py)."""
     starts = [choice.start for choice in choices]
 
     def outside(node: Node) -> bool:
@@ -476,8 +479,14 @@ def _merge(
     found = {name: [n for n in nodes if outside(n)] for name, nodes in base.found.items()}
     standalone = [node for node in base.standalone() if outside(node)]
     decisions: list[tuple[int, str, int]] = []
+    aside: list[tuple[int, int]] = []
     for choice in choices:
         chosen = readings[choice.reader]
+        aside.extend(
+            (max(s, choice.start), min(e, choice.end))
+            for s, e in set_aside[choice.reader]
+            if s < choice.end and choice.start < e
+        )
 
         def inside(node: Node, choice: Choice = choice) -> bool:
             return choice.start <= node.start_byte and node.end_byte <= choice.end
@@ -487,4 +496,4 @@ def _merge(
         standalone.extend(filter(inside, chosen.standalone()))
         blanked = directives[choice.reader]
         decisions.extend(d for d in blanked if choice.start <= d[0] < choice.end)
-    return Composite(base.root, found, standalone, decisions)
+    return Composite(base.root, found, standalone, decisions, set_aside=aside)

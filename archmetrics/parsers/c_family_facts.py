@@ -43,6 +43,7 @@ class Composite:
     standalone: list[Node]
     directive_decisions: list[tuple[int, str, int]] = field(default_factory=list)
     hidden_comments: list[tuple[int, int]] = field(default_factory=list)  # blanked to parse
+    set_aside: list[tuple[int, int]] = field(default_factory=list)  # #if branches not read
 
 
 def facts(
@@ -67,6 +68,11 @@ def facts(
     )
     slots, nested = function_slots(made, data, scopes)
     suspects = suspect_regions(found, data, slots, nested, made, explained)
+    suspects += [
+        (*whole_lines(data, start, end), "branch")
+        for start, end in reading.set_aside
+        if data[start:end].strip()
+    ]
     trust = None
     if suspects and second_reading:
         trust = _Trust.of(slots, suspects, data, language, scopes)

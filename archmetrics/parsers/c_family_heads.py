@@ -146,13 +146,22 @@ def _operator(toks: list[Token], head: list[int], at: int) -> tuple[int, bytes] 
     return None
 
 
+def _initializer_list(
+    toks: list[Token], head: list[int], top: list[int], groups: list[tuple[int, int]]
+) -> int:
+    """Where a constructor's initializer list starts in ``head``: its first `:` outside
+    brackets after a parameter list (``Foo(int a) : a_(a)``, ``Foo(bool b) NOEXCEPT :
+    data_()``), or the head's end."""
+    if not groups:
+        return len(head)
+    first = groups[0][1]
+    return next((p for p in top if p > first and toks[head[p]][1] == b":"), len(head))
+
+
 def _declarator(toks: list[Token], head: list[int]) -> tuple[str, int, str] | None:
     """The function's name, position and qualifier, if ``head`` is a function's."""
     top, groups = _layout(toks, head)
-    colon = next(
-        (p for p in top if toks[head[p]][1] == b":" and p and toks[head[p - 1]][1] == b")"),
-        len(head),
-    )  # fmt: skip  (a constructor's initializer list starts at a `:` after its `)`)
+    colon = _initializer_list(toks, head, top, groups)
     named = [
         found
         for opened, _ in groups

@@ -24,7 +24,8 @@ from archmetrics.parsers.c_family_heads import (
     opens_kr,
 )
 
-# a token: (kind, text, byte offset); kinds: w word, p directive, q string, o operator
+# a token: (kind, text, byte offset); kinds: w word, p directive, q string, n number,
+# o operator
 Token = tuple[str, bytes, int]
 
 _TOKENS = re.compile(
@@ -57,12 +58,11 @@ _NOT_CALLED = frozenset(
 
 
 def tokens(data: bytes, start: int = 0, end: int | None = None) -> list[Token]:
-    """The tokens of ``data[start:end]`` that the reading needs: comments and numbers
-    dropped."""
+    """The tokens of ``data[start:end]``, comments dropped."""
     return [
         (kind, found.group(), found.start())
         for found in _TOKENS.finditer(data, start, len(data) if end is None else end)
-        if (kind := found.lastgroup or "s") not in ("s", "n")
+        if (kind := found.lastgroup or "s") != "s"
     ]
 
 

@@ -80,15 +80,19 @@ def areas_of(regions: Iterable[tuple[int, int, str]]) -> list[Area]:
 
 
 def _macro_names(data: bytes) -> frozenset[str]:
-    """The macros the file defines whose body is no function head (``#define OP(m) {...},``):
-    a function named after one of them is none."""
+    """The macros the file defines whose body does not end in a function head
+    (``#define OP(m) {NAME(#m), CHILD(m)},``): a function named after one of them is none.
+    A body that ends in a head after its last `;` or `}` (``#define TEST_BEGIN(f) static
+    void f(void)``, a test macro that defines a class and then its method's head) makes
+    real functions named after it."""
     names = set()
     for found in _DEFINE.finditer(data):
         body = found.group(3).replace(b"\\\n", b" ").rstrip(b" \t\\")
-        outside = _PARENTHESES.sub(b"", body)
+        last = body[max(body.rfind(b";"), body.rfind(b"}")) + 1 :]
+        outside = _PARENTHESES.sub(b"", last)
         while outside != (inner := _PARENTHESES.sub(b"", outside)):
-            outside = inner  # the parameter lists' commas are no declaration's
-        head_like = body.endswith((b")", b"const")) and not any(c in outside for c in b"{};,=")
+            outside = inner  # a default argument's `=` is no initializer's
+        head_like = last.rstrip().endswith((b")", b"const")) and b"=" not in outside
         if not head_like:
             names.add(found.group(1).decode("utf-8", "replace"))
     return frozenset(names)
@@ -97,14 +101,20 @@ def _macro_names(data: bytes) -> frozenset[str]:
 def _matches(
     slots: list[FunctionSlot], functions: list[TokenFunction], lines: Lines
 ) -> dict[int, int]:
-    """slot index -> token function index, where both readings found one function: the
-    same body, from its `{` to its last line."""
+    """slot index -> token function index, where both readings found one function: to the
+    same last line, from the same body or under the same name (the two readings may take
+    different `{`s of a head spelled twice in #if branches)."""
     by_body = {function.body_start: index for index, function in enumerate(functions)}
+    by_end: dict[tuple[int, str], int] = {}
+    for index, function in enumerate(functions):
+        by_end.setdefault((lines.of(function.end - 1), function.name), index)
     matched: dict[int, int] = {}
     for at, slot in enumerate(slots):
-        index = by_body.get(slot.body_start)
-        if index is not None and lines.of(functions[index].end - 1) == slot.span.end:
-            matched[at] = index
+        found = by_body.get(slot.body_start)
+        if found is None or lines.of(functions[found].end - 1) != slot.span.end:
+            found = by_end.get((slot.span.end, slot.name))
+        if found is not None:
+            matched[at] = found
     return matched
 
 
@@ -176,11 +186,8 @@ def reconcile(
             kept.append(slot)
         elif at in matched and not keyword:
             token = functions[matched[at]]
-            if area is not None and not slot.name.startswith(token.name):  # a misread head
-                area.renamed.append((slot.qualified, token.qualified))
-                slot.name, slot.qualified = token.name, token.qualified
-                slot.span = Span(min(lines.of(token.start), slot.span.end), slot.span.end)
-                slot.start = max(slot.start, token.start)
+            if area is not None:
+                _adopt_head(slot, token, area, functions, lines)
             kept.append(slot)
             pairs[id(slot)] = token
         elif not keyword and slot.name not in macros and not _replaced(slot, functions):
@@ -200,6 +207,27 @@ def reconcile(
         area.added.append(added)
     kept.sort(key=lambda slot: slot.start)
     return kept, areas, pairs
+
+
+def _adopt_head(
+    slot: FunctionSlot,
+    token: TokenFunction,
+    area: Area,
+    functions: list[TokenFunction],
+    lines: Lines,
+) -> None:
+    """Where the tree misread a function's head, the token reading's: its name, when the
+    tree named it after a macro before it (``GENERATE_TEST(a) ... int main(void) {``),
+    and its start, when the tree's head holds other functions (a class read as the head
+    of the function after its methods)."""
+    renamed = not slot.name.startswith(token.name)
+    swallowed = any(slot.start <= f.start < token.start for f in functions if f is not token)
+    if renamed:
+        area.renamed.append((slot.qualified, token.qualified))
+        slot.name, slot.qualified = token.name, token.qualified
+    if renamed or swallowed:
+        slot.span = Span(min(lines.of(token.start), slot.span.end), slot.span.end)
+        slot.start = max(slot.start, token.start)
 
 
 def _area_for(areas: list[Area], slot: FunctionSlot) -> Area:

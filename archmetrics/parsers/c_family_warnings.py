@@ -28,6 +28,7 @@ _CAUSES = {
     "stray": "a block outside any function (a K&R definition or a macro?)",
     "keyword": "a macro read as a function's head",
     "head": "macro calls without their ';' read as a function's head",
+    "branch": "an #if branch read apart from the others",
 }
 
 
@@ -58,7 +59,7 @@ def _cause(area: Area, reading: TokenReading, data: bytes) -> str:
         return "a #define inside an initializer"
     if _ASM.search(data, start, end):
         return "inline assembly"
-    for cause in ("keyword", "head", "nested", "stray"):
+    for cause in ("keyword", "head", "nested", "stray", "branch"):
         if cause in area.causes:
             return _CAUSES[cause]
     if _CONDITIONAL.search(data, start, end):

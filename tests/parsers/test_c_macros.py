@@ -336,10 +336,14 @@ def test_one_broken_spot_no_longer_takes_the_rest_of_the_file(language: str) -> 
     )
     assert len(facts.functions) == 21
     # the #if is one decision; the && in its condition is not (lizard reads a directive as
-    # one token). The two spellings of the loop's head do not parse together, so the
-    # region is read with its first branch only: while, && (lizard, reading tokens, has 6)
-    assert complexities(facts)["f"] == 4
-    assert [d.line for d in facts.functions[0].decisions] == [3, 5, 5]
+    # one token). The two spellings of the loop's head do not parse together, so the tree
+    # reads the region with its first branch only; the token reading counts the other
+    # branch's while and && too (every branch as written, as lizard has it: 6), and f is
+    # estimated, under a warning
+    assert complexities(facts)["f"] == 6
+    assert [d.line for d in facts.functions[0].decisions] == [3, 5, 5, 7, 7]
+    assert facts.functions[0].estimated
+    assert [w.line for w in facts.warnings] == [6]
     assert all(complexities(facts)[f"g{i}"] == 2 for i in range(20))
 
 
@@ -493,7 +497,13 @@ def test_the_lines_captured_around_the_damage_do_not_change_the_facts(
     usual = [facts_of(source, language) for language, source in _BRANCHY]
     monkeypatch.setattr(c_family, "_CONTEXT_LINES", lines)
     assert [facts_of(source, language) for language, source in _BRANCHY] == usual
-    assert all(facts.functions and not facts.warnings for facts in usual)
+    assert all(facts.functions for facts in usual)
+    # what a spelling of one branch sets aside is read from tokens, under a warning
+    assert all(
+        warning.message.endswith("(an #if branch read apart from the others)")
+        for facts in usual
+        for warning in facts.warnings
+    )
 
 
 @LANGUAGES
