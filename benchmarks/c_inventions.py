@@ -20,6 +20,7 @@ A function of lizard's is its invention (left out of "lizard's real functions") 
     lose its way: it reads on to some later ``}``);
   * it lies inside a multi-line ``#define`` (lizard reads a macro's body as code; the
     function exists only where the macro is used);
+  * it lies inside another function lizard reports (``HWY_IF_CONSTEXPR(c) {`` in a body);
   * it is a method of a class defined inside one of our functions (our rule, and lizard's
     own when it sees the function around it: docs/metrics.md, v_g).
 """
@@ -244,6 +245,8 @@ def invention(
     inner |= {f.start for f in ours if other.start < f.start and f.end <= other.end}
     if len(inner) >= 2:
         return "spans other functions"
+    if any(f.start < other.start and other.end <= f.end for f in theirs if f is not other):
+        return "inside another of its functions"
     if any(s <= other.start and other.end <= e for s, e in local_classes):
         return "method of a class inside a function"
     return None

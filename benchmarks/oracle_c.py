@@ -251,6 +251,8 @@ def _warnings_checked(
                 function = next(f for f in syntax.functions if f.span.start == mine.start)
                 lost = _disagreement_class(lines, function, other.vg) == "unexplained"
         claims = message.split(" (")[0]
+        if not lost and "function" in claims:  # lizard may lose them too: the source's own
+            lost = _swallowed(tree, lines, first, last)  # heads, at the start of a line
         if not lost and ("statement" in claims or "call site" in claims):
             lost = _recounted(syntax, source, first, last, claims)
         renamed = _RENAMED.search(claims)
@@ -270,6 +272,28 @@ def _warnings_checked(
 
 
 _RENAMED = re.compile(r"the head of (\S+) read as")
+# a function's head as C code writes it at file scope: at a line's start, a name and a `(`,
+# not a statement or a declaration (no `;` at its end), and its body's `{` on that line or
+# the next line's start
+_HEAD = re.compile(
+    r"(?:[A-Za-z_][\w\s*&:<>,]*[\s*&])?(?!(?:if|for|while|switch|return)\b)[A-Za-z_]\w*\s*\([^;]*$"
+)
+
+
+def _swallowed(tree: list[c_inventions.Ours], lines: list[str], first: int, last: int) -> bool:
+    """Whether a function of the tree alone that overlaps lines ``first``..``last`` holds,
+    after its own first lines, another function's head at the start of a line: a head at
+    column 0 whose body's `{` ends it or starts the next line (checked on the text, not by
+    either reading; lizard loses such functions too, where its reading derails)."""
+    for function in tree:
+        if not (function.start <= last and first <= function.end):
+            continue
+        for number in range(function.start + 2, function.end - 1):
+            line = lines[number - 1]
+            following = lines[number] if number < len(lines) else ""
+            if _HEAD.match(line) and (line.rstrip().endswith("{") or following.startswith("{")):
+                return True
+    return False
 
 
 def _recounted(syntax: FileFacts, source: str, first: int, last: int, claims: str) -> bool:

@@ -4,6 +4,7 @@ the statements, decisions and call sites the walker finds are counted in (c_fami
 from __future__ import annotations
 
 import bisect
+import re
 from dataclasses import dataclass, field
 
 from tree_sitter import Node
@@ -76,6 +77,24 @@ class Owners:
         return found
 
 
+# `HEAP_EXPORT(void heap_init(struct heap* h))`: a type, a name, its parameters, nothing else
+_WRAPPED = re.compile(
+    rb"\(\s*+(?:[A-Za-z_][\w:]*+[\s*&]++)++([A-Za-z_]\w*+)\s*+\((?:[^(),]|,|\([^()]*+\))*+\)\s*+\)\Z"
+)
+
+
+def wrapped_name(head: Node, data: bytes) -> str | None:
+    """The name a wrapper macro's argument declares, for a macro-made definition whose
+    head is such a call (``UV_UNUSED(static void uv__update_time(uv_loop_t* loop)) {``):
+    the function is that one, named as the code names it."""
+    call = head.named_child(0) if head.named_child_count else None
+    arguments = call.child_by_field_name("arguments") if call is not None else None
+    if arguments is None:
+        return None
+    found = _WRAPPED.match(data, arguments.start_byte, arguments.end_byte)
+    return found.group(1).decode("utf-8", "replace") if found else None
+
+
 def function_slots(
     definitions: list[Definition], data: bytes, scopes: Scopes
 ) -> tuple[list[FunctionSlot], list[Definition]]:
@@ -97,7 +116,8 @@ def function_slots(
             name, qualified = function_name(node, data, prefix)
             parameters = function_parameters(node, data)
         else:
-            name, qualified = definition.macro, f"{prefix}::{definition.macro}".lstrip(":")
+            name = wrapped_name(node, data) or definition.macro
+            qualified = f"{prefix}::{name}".lstrip(":")
         slots.append(
             FunctionSlot(
                 name,

@@ -158,6 +158,29 @@ def _initializer_list(
     return next((p for p in top if p > first and toks[head[p]][1] == b":"), len(head))
 
 
+def _wrapped(toks: list[Token], head: list[int], opened: int, closed: int) -> int | None:
+    """The position of the name a wrapper macro's argument declares, if the group from
+    ``opened`` to ``closed`` holds a function's head: ``HEAP_EXPORT(void heap_init(struct
+    heap* h))``, ``UV_UNUSED(static void f(uv_loop_t* loop))`` (a type before the name, no
+    comma outside the inner parameter list)."""
+    if toks[head[closed - 1]][1] != b")":
+        return None
+    depth, inner = 0, -1
+    for position in range(closed - 1, opened, -1):
+        text = toks[head[position]][1]
+        depth += (text == b")") - (text == b"(")
+        if depth == 0:
+            inner = position
+            break
+    name = inner - 1
+    if name <= opened + 1 or toks[head[name]][0] != "w" or toks[head[name]][1] in KEYWORDS:
+        return None
+    before = [toks[head[p]] for p in range(opened + 1, name)]
+    if any(text == b"," for _, text, _ in before) or not any(k == "w" for k, _, _ in before):
+        return None
+    return name
+
+
 def _declarator(toks: list[Token], head: list[int]) -> tuple[str, int, str] | None:
     """The function's name, position and qualifier, if ``head`` is a function's."""
     top, groups = _layout(toks, head)
@@ -170,7 +193,13 @@ def _declarator(toks: list[Token], head: list[int]) -> tuple[str, int, str] | No
     if not named:
         return None
     lower = [found for found in named if not _capitals(found[0].encode())]
-    return (lower or named)[-1]
+    chosen = (lower or named)[-1]
+    if not lower:  # a wrapper macro around a declaration: the name it declares
+        group = next(g for g in groups if g[0] == chosen[1] + 1)
+        inner = _wrapped(toks, head, *group)
+        if inner is not None:
+            return toks[head[inner]][1].decode("utf-8", "replace"), inner, ""
+    return chosen
 
 
 def classify(toks: list[Token], head: list[int], scope: str) -> Head:

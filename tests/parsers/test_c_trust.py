@@ -546,3 +546,28 @@ def test_braces_that_never_close_are_warned_about(language: str) -> None:
     )
     assert "ok" in [f.name for f in facts.functions]
     assert any("never close" in message for message in messages(facts))
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_a_wrapper_macro_around_a_head_names_no_function(language: str) -> None:
+    # libuv: `#define UV_UNUSED(declaration) __attribute__((unused)) declaration`; the
+    # function is the one its argument declares (tree-sitter reads it cleanly, as a
+    # function named UV_UNUSED with one parameter that declares a function)
+    facts = facts_of(
+        """\
+        UV_UNUSED(static void update_time(uv_loop_t* loop)) {
+          if (loop) loop->time = 1;
+        }
+
+        HEAP_EXPORT(void heap_init(struct heap* heap, int n)) {
+          heap->min = n ? NULL : heap;
+        }
+        """,
+        language,
+    )
+    assert [(f.name, f.complexity) for f in facts.functions] == [
+        ("update_time", 2),
+        ("heap_init", 2),
+    ]
+    if language == "cpp":  # read as a function definition: its parameters are known
+        assert [f.parameters for f in facts.functions] == [("loop",), ("heap", "n")]
