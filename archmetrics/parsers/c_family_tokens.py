@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from archmetrics.parsers.c_family_heads import (
     CLASS,
     FUNCTION,
+    KEYWORDS,
     NAMESPACE,
     Head,
     classify,
@@ -49,12 +50,7 @@ _WORD_DECISIONS = {b"if": "if", b"for": "for", b"while": "while", b"case": "case
 _CPP_WORDS = {b"catch": "catch", b"and": "&&", b"or": "||"}
 _NOT_REFERENCE = frozenset({b")", b",", b">", b"...", b"="})
 _HEADER_WORDS = frozenset({b"if", b"for", b"switch", b"case", b"default", b"catch", b"while"})
-_NOT_CALLED = frozenset(
-    {b"if", b"for", b"while", b"switch", b"return", b"sizeof", b"catch", b"alignof",
-     b"decltype", b"defined", b"new", b"delete", b"throw", b"case", b"else", b"do",
-     b"static_assert", b"alignas", b"noexcept", b"typeid", b"__attribute__", b"__declspec",
-     b"_Alignof", b"_Static_assert", b"__typeof__", b"typeof", b"requires"}
-)  # fmt: skip
+_NOT_CALLED = KEYWORDS | {b"defined", b"__typeof", b"_Pragma", b"__pragma"}  # casts too: int(x)
 
 
 def tokens(data: bytes, start: int = 0, end: int | None = None) -> list[Token]:
