@@ -124,8 +124,11 @@ _REGION = re.compile(r"lines? (\d+)(?:-(\d+))?:")
 
 
 def _regions(facts: FileFacts) -> list[tuple[int, int, str]]:
-    """(first line, last line, message) of each warning about a region."""
+    """(first line, last line, message) of each warning about a region; a file not
+    measured at all is one region."""
     found = []
+    if not facts.parsed:
+        return [(1, 1 << 30, w.message) for w in facts.warnings[:1]]
     for warning in facts.warnings:
         matched = _REGION.match(warning.message)
         if matched:

@@ -186,16 +186,15 @@ def _declarator(toks: list[Token], head: list[int]) -> tuple[str, int, str] | No
     top, groups = _layout(toks, head)
     colon = _initializer_list(toks, head, top, groups)
     named = [
-        found
-        for opened, _ in groups
+        (found, (opened, closed))
+        for opened, closed in groups
         if opened < colon and (found := _name(toks, head, opened)) is not None
     ]
     if not named:
         return None
-    lower = [found for found in named if not _capitals(found[0].encode())]
-    chosen = (lower or named)[-1]
+    lower = [item for item in named if not _capitals(item[0][0].encode())]
+    chosen, group = (lower or named)[-1]
     if not lower:  # a wrapper macro around a declaration: the name it declares
-        group = next(g for g in groups if g[0] == chosen[1] + 1)
         inner = _wrapped(toks, head, *group)
         if inner is not None:
             return toks[head[inner]][1].decode("utf-8", "replace"), inner, ""

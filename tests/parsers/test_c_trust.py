@@ -571,3 +571,22 @@ def test_a_wrapper_macro_around_a_head_names_no_function(language: str) -> None:
     ]
     if language == "cpp":  # read as a function definition: its parameters are known
         assert [f.parameters for f in facts.functions] == [("loop",), ("heap", "n")]
+
+
+def test_a_qualified_name_in_capitals_in_a_file_read_from_tokens() -> None:
+    # re2's pcre.cc: `PCRE::PCRE(...)` (a class named in capitals) crashed the token
+    # reading, and the whole file went unmeasured
+    facts = cpp(
+        """\
+        PCRE::PCRE(const char* pattern) {
+          if (pattern) Init(pattern);
+        }
+
+        int broken(int a) { @ if (a) return 1; return 0; }
+        """
+    )
+    assert facts.parsed
+    assert [(f.qualified_name, f.complexity) for f in facts.functions] == [
+        ("PCRE::PCRE", 2),
+        ("broken", 2),
+    ]
