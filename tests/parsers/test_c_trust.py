@@ -578,15 +578,15 @@ def test_a_qualified_name_in_capitals_in_a_file_read_from_tokens() -> None:
     # reading, and the whole file went unmeasured
     facts = cpp(
         """\
+        int broken(int a) { @ if (a) return 1; return 0; }
+
         PCRE::PCRE(const char* pattern) {
           if (pattern) Init(pattern);
         }
-
-        int broken(int a) { @ if (a) return 1; return 0; }
         """
     )
     assert facts.parsed
     assert [(f.qualified_name, f.complexity) for f in facts.functions] == [
-        ("PCRE::PCRE", 2),
         ("broken", 2),
+        ("PCRE::PCRE", 2),
     ]
