@@ -40,6 +40,7 @@ _TOKENS = re.compile(
     re.M | re.S,
 )
 _DIRECTIVE = re.compile(rb"[ \t]*+\#[ \t]*+(\w*)")
+_LONGEST_KR = 1_000  # tokens: a K&R head with its parameters' declarations is shorter
 #: directive keywords that are decisions in a body (docs/metrics.md, v_g table)
 _DECIDING = frozenset({b"if", b"ifdef", b"ifndef", b"elif", b"elifdef", b"elifndef"})
 #: directives that are one statement each (λ table)
@@ -103,9 +104,12 @@ class _State:
     in_head: bool = False  # the block skipped is part of the head (`a_{1}`, a lambda)
 
     def copy(self) -> _State:
+        """A copy for an #if branch to return to. The head is shared, not copied: a head
+        may run over thousands of #if groups (macros without `;`), and a head read in two
+        branches is still one head (``int f(int a)`` / ``#else`` / ``int f(long a)``)."""
         return _State(
             list(self.scopes),
-            list(self.head),
+            self.head,
             self.function,
             self.depth,
             self.parens,
@@ -283,7 +287,9 @@ class _Reader:
             )  # after a K&R head's earlier declarations
             if begins < len(head):
                 self.statements.append(self.toks[head[begins]][2])
-        if state.kr or (len(state.scopes) == 1 and opens_kr(self.toks, state.head)):
+        if len(head) > _LONGEST_KR:  # no K&R head is this long: no quadratic walk back
+            state.kr = False
+        elif state.kr or (len(state.scopes) == 1 and opens_kr(self.toks, head)):
             state.kr = True
             state.head.append(index)
             return
