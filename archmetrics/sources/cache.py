@@ -210,7 +210,7 @@ class FactsCache:
         """A function that reads the body of the record kept for ``blob`` and ``language``
         (None if there is none now), also after the cache was closed: facts decoded from the
         cache read their statements and call sites back from it on first use instead of
-        holding them (docs/performance.md, session 10)."""
+        holding them (docs/performance.md, "Warm diffs")."""
         key = (blob, language, self.fingerprint)
         # a weak reference: facts the cache remembers must not hold the cache (a cycle
         # through every decoded fact would be left to the garbage collector)
