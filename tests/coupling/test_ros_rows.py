@@ -1,0 +1,127 @@
+"""The ROS oracle's row format and matching rule, and the committed oracle's own consistency."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from tests.coupling.ros_adapter import CATEGORIES, KIND_CATEGORY, kind_family
+from tests.coupling.ros_rows import (
+    LINE_SLACK,
+    NAMED_STATIC,
+    is_test_path,
+    match_sites,
+    parse_rows,
+)
+
+ORACLE = Path(__file__).resolve().parents[2] / "benchmarks" / "ros_oracle"
+HEADER = "file|line|end|kind|name|type|from|written|launch|note"
+
+
+def _rows(*lines: str) -> str:
+    return "\n".join(["# a comment", HEADER, *lines])
+
+
+def test_rows_are_read_with_their_launch_names_and_test_flag() -> None:
+    [row, other] = parse_rows(
+        _rows(
+            'src/a.cpp|10|12|publisher|/chatter|std_msgs/msg/String|literal|"chatter"|'
+            "/ns/chatter@launch/x.launch.py;/other@launch/y.xml|note",
+            "pkg/test/t.py|3|3|subscription|/a;/b|std_msgs/msg/String|argument|topic||",
+        ),
+        "demo.sites",
+    )
+    assert (row.file, row.line, row.end, row.kind) == ("src/a.cpp", 10, 12, "publisher")
+    assert row.launch_names == ("/ns/chatter", "/other") and not row.test
+    assert row.accepts("/chatter") and row.accepts("/ns/chatter") and not row.accepts("/x")
+    assert other.names == ("/a", "/b") and other.test and not other.accepts(None)
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ("a.cpp|1|1|publisher|/x", "demo.sites:3: 5 columns"),
+        ("a.cpp|1|1|publishr|/x|t|literal|w||", "demo.sites:3: unknown kind or from"),
+        ("a.cpp|1|1|publisher|/x|t|guessed|w||", "demo.sites:3: unknown kind or from"),
+    ],
+)
+def test_a_bad_row_names_its_line(line: str, message: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(message)):
+        parse_rows(_rows(line), "demo.sites")
+
+
+def test_sites_match_rows_nearest_first_within_the_slack() -> None:
+    rows = parse_rows(
+        _rows(
+            "a.cpp|10|12|publisher|/p|t|literal|w||",
+            "a.cpp|11|11|publish|/p|t|literal|w||",
+            "a.cpp|30|30|subscription|/s|t|literal|w||",
+        ),
+        "demo.sites",
+    )
+    sites = [
+        {"path": "a.cpp", "line": 11},  # nearest to the publish row (line 11), not the publisher
+        {"path": "a.cpp", "line": 10 - LINE_SLACK},  # the statement's first line, for line 10
+        {"path": "a.cpp", "line": 27},  # too far before line 30
+        {"path": "b.cpp", "line": 1},
+    ]
+    match = match_sites(rows, sites)
+    assert sorted((row.line, site["line"]) for row, site in match.pairs) == [(10, 8), (11, 11)]
+    assert [row.line for row in match.missed] == [30]
+    assert sorted((s["path"], s["line"]) for s in match.extra) == [("a.cpp", 27), ("b.cpp", 1)]
+
+
+@pytest.mark.parametrize(
+    ("path", "test"),
+    [
+        ("pkg/test/helper.cpp", True),
+        ("pkg/tests/unit/x.py", True),
+        ("pkg/launch_testing/check_msgs_launch_test.py", True),
+        ("pkg/src/test_utils.cpp", True),
+        ("pkg/src/contest.cpp", False),
+        ("pkg/src/testing_node.cpp", False),
+    ],
+)
+def test_test_files(path: str, test: bool) -> None:
+    assert is_test_path(path) is test
+
+
+def test_every_kind_has_one_category_and_a_family() -> None:
+    kinds = [kind for group in CATEGORIES.values() for kind in group]
+    assert len(kinds) == len(set(kinds)) == len(KIND_CATEGORY)
+    assert kind_family("tf-listener") == "subscription" == kind_family("mf-subscriber")
+
+
+def _oracle() -> list[tuple[str, str]]:
+    document = tomllib.loads((ORACLE / "repos.toml").read_text(encoding="utf-8"))
+    return [(entry["name"], entry["sites"]) for entry in document["repo"]]
+
+
+def test_the_oracle_pins_every_repository_to_a_commit() -> None:
+    document = tomllib.loads((ORACLE / "repos.toml").read_text(encoding="utf-8"))
+    names = [entry["name"] for entry in document["repo"]]
+    assert len(names) == len(set(names)) >= 5
+    assert {entry["ros"] for entry in document["repo"]} == {1, 2}
+    for entry in document["repo"]:
+        assert re.fullmatch(r"[0-9a-f]{40}", entry["commit"]), entry["name"]
+        assert (ORACLE / entry["sites"]).is_file(), entry["sites"]
+    assert sorted(p.name for p in ORACLE.glob("*.sites")) == sorted(s for _, s in _oracle())
+
+
+@pytest.mark.parametrize(("repo", "sites"), _oracle(), ids=[name for name, _ in _oracle()])
+def test_the_oracle_rows_are_consistent(repo: str, sites: str) -> None:
+    rows = parse_rows((ORACLE / sites).read_text(encoding="utf-8"), sites)
+    assert rows, repo
+    for row in rows:
+        where = f"{sites}: {row.file}:{row.line}"
+        assert 1 <= row.line <= row.end, where
+        communication = KIND_CATEGORY[row.kind] == "communication"
+        if communication and row.given in NAMED_STATIC:
+            assert row.names, f"{where}: a static name must be written down"
+        if communication or row.kind.startswith("launch"):
+            assert all(n.startswith(("/", "~")) for n in row.names + row.launch_names), where
+    keys = [(row.file, row.line, row.kind) for row in rows]
+    assert len(keys) == len(set(keys)), f"{sites}: a site is listed twice"
