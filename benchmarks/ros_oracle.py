@@ -247,7 +247,7 @@ def run(repos: Iterable[Repo], args: argparse.Namespace) -> None:
         sites = [s for s in scan(tree, repo, command)
                  if is_ros_site(s) and repo.in_scope(str(s["path"]))]  # fmt: skip
         rows = [row for row in repo.rows if repo.in_scope(row.file)]
-        match = match_sites(rows, sites)
+        match = match_sites(rows, sites, lambda site: ros_endpoint(site)[0])
         report_repo(repo, match, args.markdown)
         if args.details:
             details(match)

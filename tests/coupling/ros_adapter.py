@@ -68,12 +68,16 @@ def is_ros_site(site: Mapping[str, object]) -> bool:
 
 
 def ros_endpoint(site: Mapping[str, object]) -> tuple[str, str | None, str | None]:
-    """(kind family, resolved name or None, type or None) of one reported link site."""
+    """(kind family, resolved name or None, type or None) of one reported link site.
+
+    A site whose ``status`` is ``unresolved`` has no name, whatever its ``endpoint`` says.
+    """
     rule_id = str(site.get("rule", "")).split("/", 1)[-1].replace("_", "-").lower()
     kind = next((k for piece, k in _RULE_KINDS if piece in rule_id), None)
     if kind is None:
         kind = "subscription" if site.get("role") == "receive" else "publish"
     endpoint = site.get("endpoint")
-    name = str(endpoint).split(":", 1)[-1] if endpoint else None
+    named = endpoint and site.get("status") != "unresolved"
+    name = str(endpoint).split(":", 1)[-1] if named else None
     ros_type = next((str(site[k]) for k in _TYPE_KEYS if site.get(k)), None)
     return kind, name, ros_type

@@ -7,15 +7,15 @@ test_ros_oracle_slice.py) share this format: ``|``-separated cells under the hea
 (benchmarks/ros_oracle/README.md says what every column means). A reported site matches a row
 of the same file when its line lies in ``[line - LINE_SLACK, end]`` (a tool may report the
 statement's first line rather than the callee's); each row and each site is matched at most
-once, nearest line first.
+once, nearest line first, and among equally near ones a site whose kind agrees with the row's.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
-from tests.coupling.ros_adapter import KIND_CATEGORY
+from tests.coupling.ros_adapter import KIND_CATEGORY, kind_family
 
 COLUMNS = ("file", "line", "end", "kind", "name", "type", "from", "written", "launch", "note")
 LINE_SLACK = 2
@@ -96,8 +96,22 @@ def parse_rows(text: str, source: str) -> list[Row]:
     return rows
 
 
-def match_sites(rows: Iterable[Row], sites: Iterable[Mapping[str, object]]) -> Match:
-    """Pair rows and reported sites of one tree by file and line (LINE_SLACK, nearest first)."""
+def _disagree(
+    row: Row, site: Mapping[str, object], kind_of: Callable[[Mapping[str, object]], str] | None
+) -> bool:
+    return kind_of is not None and kind_of(site) != kind_family(row.kind)
+
+
+def match_sites(
+    rows: Iterable[Row],
+    sites: Iterable[Mapping[str, object]],
+    kind_of: Callable[[Mapping[str, object]], str] | None = None,
+) -> Match:
+    """Pair rows and reported sites of one tree by file and line (LINE_SLACK, nearest first).
+
+    ``kind_of`` gives a site's kind family (``ros_endpoint(site)[0]``); it only decides between
+    equally near pairs, e.g. a subscription and the publish call in its callback on one line.
+    """
     by_file: dict[str, list[Mapping[str, object]]] = {}
     for site in sites:
         by_file.setdefault(str(site["path"]), []).append(site)
@@ -106,14 +120,14 @@ def match_sites(rows: Iterable[Row], sites: Iterable[Mapping[str, object]]) -> M
         candidates = by_file.get(file, [])
         file_rows = [row for row in rows if row.file == file]
         options = sorted(
-            (abs(int(str(site["line"])) - row.line), i, j)
+            (abs(int(str(site["line"])) - row.line), _disagree(row, site, kind_of), i, j)
             for i, row in enumerate(file_rows)
             for j, site in enumerate(candidates)
             if row.line - LINE_SLACK <= int(str(site["line"])) <= row.end
         )
         used_rows: set[int] = set()
         used_sites: set[int] = set()
-        for _, i, j in options:
+        for _, _, i, j in options:
             if i not in used_rows and j not in used_sites:
                 used_rows.add(i)
                 used_sites.add(j)

@@ -8,16 +8,24 @@ from pathlib import Path
 
 import pytest
 
-from tests.coupling.ros_adapter import CATEGORIES, KIND_CATEGORY, kind_family
+from tests.coupling.ros_adapter import (
+    CATEGORIES,
+    KIND_CATEGORY,
+    is_ros_site,
+    kind_family,
+    ros_endpoint,
+)
 from tests.coupling.ros_rows import (
     LINE_SLACK,
     NAMED_STATIC,
+    Row,
     is_test_path,
     match_sites,
     parse_rows,
 )
 
 ORACLE = Path(__file__).resolve().parents[2] / "benchmarks" / "ros_oracle"
+CASES = Path(__file__).resolve().parent / "ros_cases"
 HEADER = "file|line|end|kind|name|type|from|written|launch|note"
 
 
@@ -74,6 +82,25 @@ def test_sites_match_rows_nearest_first_within_the_slack() -> None:
     assert sorted((s["path"], s["line"]) for s in match.extra) == [("a.cpp", 27), ("b.cpp", 1)]
 
 
+def test_equally_near_sites_pair_with_the_row_of_their_kind() -> None:
+    rows = parse_rows(
+        _rows(
+            "r.py|10|10|subscription|/in|t|literal|w||",
+            "r.py|10|10|publish|/out|t|literal|w||",
+        ),
+        "demo.sites",
+    )
+    sites = [
+        {"path": "r.py", "line": 10, "kind": "publish"},
+        {"path": "r.py", "line": 10, "kind": "subscription"},
+    ]
+    match = match_sites(rows, sites, lambda site: str(site["kind"]))
+    assert sorted((row.kind, site["kind"]) for row, site in match.pairs) == [
+        ("publish", "publish"),
+        ("subscription", "subscription"),
+    ]
+
+
 @pytest.mark.parametrize(
     ("path", "test"),
     [
@@ -115,6 +142,10 @@ def test_the_oracle_pins_every_repository_to_a_commit() -> None:
 def test_the_oracle_rows_are_consistent(repo: str, sites: str) -> None:
     rows = parse_rows((ORACLE / sites).read_text(encoding="utf-8"), sites)
     assert rows, repo
+    _consistent(rows, sites)
+
+
+def _consistent(rows: list[Row], sites: str) -> None:
     for row in rows:
         where = f"{sites}: {row.file}:{row.line}"
         assert 1 <= row.line <= row.end, where
@@ -125,3 +156,29 @@ def test_the_oracle_rows_are_consistent(repo: str, sites: str) -> None:
             assert all(n.startswith(("/", "~")) for n in row.names + row.launch_names), where
     keys = [(row.file, row.line, row.kind) for row in rows]
     assert len(keys) == len(set(keys)), f"{sites}: a site is listed twice"
+
+
+def test_a_site_becomes_kind_name_and_type() -> None:
+    site = {
+        "path": "src/a.cpp", "line": 3, "rule": "ros2/cpp-create-publisher", "kind": "message",
+        "role": "send", "endpoint": "/cmd_vel", "status": "external",
+        "type": "geometry_msgs/msg/Twist", "extra": [1],
+    }  # fmt: skip
+    assert is_ros_site(site) and not is_ros_site({**site, "rule": "zeromq/socket-connect"})
+    assert ros_endpoint(site) == ("publisher", "/cmd_vel", "geometry_msgs/msg/Twist")
+    unresolved = {**site, "rule": "ros1/py-subscriber", "status": "unresolved", "type": None}
+    assert ros_endpoint(unresolved) == ("subscription", None, None)
+    assert ros_endpoint({"rule": "ros2/py-spin", "role": "receive"})[0] == "subscription"
+
+
+def test_the_slice_table_names_lines_of_its_snippets() -> None:
+    rows = parse_rows((CASES / "cases.sites").read_text(encoding="utf-8"), "cases.sites")
+    snippets = {p.relative_to(CASES).as_posix().removesuffix(".in") for p in CASES.rglob("*.in")}
+    assert {row.file for row in rows} <= snippets
+    for row in rows:
+        lines = (CASES / f"{row.file}.in").read_text(encoding="utf-8").splitlines()
+        assert 1 <= row.line <= row.end <= len(lines), f"{row.file}:{row.line}"
+        assert lines[row.line - 1].strip(), f"{row.file}:{row.line} is blank"
+    _consistent(rows, "cases.sites")
+    assert {KIND_CATEGORY[row.kind] for row in rows} == set(CATEGORIES)
+    assert not any(row.test for row in rows)
