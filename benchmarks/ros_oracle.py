@@ -12,9 +12,11 @@ bring the repository another way (``fetch github:<owner>/<name>`` in the session
 For each one the script runs ``archmetrics scan --by link --format json`` on the slice, keeps
 the sites of rule packs named ``ros*`` in labelled files, matches them to the oracle's rows
 (file, and line within [line - 2, end]) and prints per repository and per kind: recall (rows
-found), precision (reported ROS sites that are rows), and among found rows whose name is
-given statically the share whose reported endpoint carries that name (or a launch file's
-remapped name) and the share carrying the type. ``--details`` lists the unmatched rows and
+found), precision (reported ROS sites that are rows; a site that is no row counts against the
+kind its rule names), and among found rows whose name is given statically the share whose
+reported endpoint carries that name (or a launch file's remapped name) and the share carrying
+the type. Parameter values in parameter and launch files are not labelled: sites of them are
+counted apart, not judged. ``--details`` lists the unmatched rows and
 sites; ``--verify`` only checks the oracle against the trees (each row's lines exist and hold
 the expression its ``written`` cell quotes). Figures are printed for all rows and for rows
 outside tests (the issue's count).
@@ -42,6 +44,8 @@ from tests.coupling.ros_rows import (  # noqa: E402
     NAMED_STATIC,
     Match,
     Row,
+    is_test_path,
+    judged,
     match_sites,
     parse_rows,
 )
@@ -139,6 +143,7 @@ class Tally:
     static_ok: int = 0
     typed: int = 0
     typed_ok: int = 0
+    extra: int = 0
 
     def add_row(self, row: Row, site: Mapping[str, object] | None) -> None:
         self.rows += 1
@@ -162,7 +167,12 @@ def _share(part: int, whole: int) -> str:
 
 
 def tally(match: Match, outside_tests: bool) -> dict[str, Tally]:
-    """Tallies by kind, by category (``[communication]``) and in total (``all``)."""
+    """Tallies by kind, by category (``[communication]``) and in total (``all``).
+
+    A reported site that is no row counts against the precision of the kind its rule names
+    (``ros_endpoint``: a family such as ``publisher``, which also holds tf and image_transport
+    publishers).
+    """
     groups: dict[str, Tally] = {}
     entries: list[tuple[Row, Mapping[str, object] | None]] = [*match.pairs]
     entries += [(row, None) for row in match.missed]
@@ -171,15 +181,21 @@ def tally(match: Match, outside_tests: bool) -> dict[str, Tally]:
             continue
         for key in (row.kind, f"[{KIND_CATEGORY[row.kind]}]", "all"):
             groups.setdefault(key, Tally()).add_row(row, site)
+    for site in match.extra:
+        if outside_tests and is_test_path(str(site["path"])):
+            continue
+        kind = ros_endpoint(site)[0]
+        for key in (kind, f"[{KIND_CATEGORY.get(kind, '?')}]", "all"):
+            groups.setdefault(key, Tally()).extra += 1
     return groups
 
 
-def report_repo(repo: Repo, match: Match, markdown: bool) -> None:
+def report_repo(repo: Repo, match: Match, unjudged: int, markdown: bool) -> None:
     """Print the figures of one repository: per kind, per category, in total."""
     reported = len(match.pairs) + len(match.extra)
-    precision = _share(len(match.pairs), reported)
-    print(f"\n## {repo.name} @ {repo.commit[:12]}: {len(repo.rows)} rows, "
-          f"{reported} ROS sites reported in the slice, precision {precision}")  # fmt: skip
+    print(f"\n## {repo.name} @ {repo.commit[:12]}: {len(repo.rows)} rows, {reported} ROS sites "
+          f"reported in the slice (and {unjudged} parameter values in configuration files, "
+          "not judged)")  # fmt: skip
     for label, outside in (("outside tests", True), ("all rows", False)):
         groups = tally(match, outside)
         print(f"\n{label}:")
@@ -192,10 +208,10 @@ def _order(item: tuple[str, Tally]) -> tuple[bool, bool, str]:
 
 
 def _print_table(groups: Mapping[str, Tally], markdown: bool) -> None:
-    head = ("kind", "rows", "recall", "named (issue)", "named (static)", "typed")
+    head = ("kind", "rows", "recall", "precision", "named (issue)", "named (static)", "typed")
     lines = [head] + [
-        (key, str(t.rows), _share(t.found, t.rows), _share(t.named_ok, t.named),
-         _share(t.static_ok, t.static), _share(t.typed_ok, t.typed))
+        (key, str(t.rows), _share(t.found, t.rows), _share(t.found, t.found + t.extra),
+         _share(t.named_ok, t.named), _share(t.static_ok, t.static), _share(t.typed_ok, t.typed))
         for key, t in sorted(groups.items(), key=_order)
     ]  # fmt: skip
     if markdown:
@@ -246,9 +262,10 @@ def run(repos: Iterable[Repo], args: argparse.Namespace) -> None:
             continue
         sites = [s for s in scan(tree, repo, command)
                  if is_ros_site(s) and repo.in_scope(str(s["path"]))]  # fmt: skip
+        kept = [s for s in sites if judged(str(s["path"]), ros_endpoint(s)[0])]
         rows = [row for row in repo.rows if repo.in_scope(row.file)]
-        match = match_sites(rows, sites, lambda site: ros_endpoint(site)[0])
-        report_repo(repo, match, args.markdown)
+        match = match_sites(rows, kept, lambda site: ros_endpoint(site)[0])
+        report_repo(repo, match, len(sites) - len(kept), args.markdown)
         if args.details:
             details(match)
 

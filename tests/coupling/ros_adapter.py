@@ -11,6 +11,7 @@ endpoints is decided where the packs are written: adjust this one function to it
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 
 #: The oracle's kinds by category (benchmarks/ros_oracle/README.md defines each kind).
@@ -40,6 +41,10 @@ _FAMILY = {
 # (a piece of the rule id, the kind family it names); the first piece found wins. Written for
 # ids like "ros2/cpp-create-publisher" or "ros1/py-service-proxy".
 _RULE_KINDS: tuple[tuple[str, str], ...] = (
+    ("param-set", "param-set"), ("set-param", "param-set"), ("param-client", "param-client"),
+    ("parameters-client", "param-client"), ("param-remote", "param-remote"),
+    ("param-event", "param-events"), ("parameter-event", "param-events"),
+    ("reconfigure", "dynamic-reconfigure"), ("bond", "bond"),
     ("goal", "send-goal"), ("action-server", "action-server"),
     ("action-client", "action-client"), ("create-service", "service-server"),
     ("advertise-service", "service-server"), ("service-server", "service-server"),
@@ -48,12 +53,14 @@ _RULE_KINDS: tuple[tuple[str, str], ...] = (
     ("broadcaster", "publisher"), ("send-transform", "publish"), ("listener", "subscription"),
     ("publisher", "publisher"), ("advertise", "publisher"), ("publish", "publish"),
     ("subscri", "subscription"), ("message-filter", "subscription"),
-    ("declare", "param-declare"), ("set-param", "param-set"), ("param", "param-get"),
+    ("declare", "param-declare"), ("param", "param-get"),
     ("class-loader", "plugin-load"), ("instance", "plugin-load"), ("plugin-load", "plugin-load"),
     ("plugin-description", "plugin-description"), ("plugin-xml", "plugin-description"),
     ("export", "plugin-export"), ("launch-component", "launch-component"),
     ("launch", "launch-node"), ("component", "component-register"),
 )  # fmt: skip
+#: A leading "topic:", "service:", ... on an endpoint; "demo::Talker" keeps its "::".
+_SCHEME = re.compile(r"^[A-Za-z][\w-]*:(?!:)")
 _TYPE_KEYS = ("type", "msg_type", "message_type", "interface_type", "ros_type")
 
 
@@ -78,6 +85,6 @@ def ros_endpoint(site: Mapping[str, object]) -> tuple[str, str | None, str | Non
         kind = "subscription" if site.get("role") == "receive" else "publish"
     endpoint = site.get("endpoint")
     named = endpoint and site.get("status") != "unresolved"
-    name = str(endpoint).split(":", 1)[-1] if named else None
+    name = _SCHEME.sub("", str(endpoint), count=1) if named else None
     ros_type = next((str(site[k]) for k in _TYPE_KEYS if site.get(k)), None)
     return kind, name, ros_type

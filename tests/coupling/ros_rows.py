@@ -66,6 +66,24 @@ def is_test_path(path: str) -> bool:
     )
 
 
+def judged(path: str, kind: str) -> bool:
+    """Does the oracle judge a reported site of this kind family in this file?
+
+    Parameter values written in parameter and launch files (YAML ``ros__parameters``, ``<param>``,
+    ``<rosparam>``, launch_ros ``parameters=[...]``) are configuration the oracle does not label:
+    a site in a YAML file that is not a launch file, or of a parameter kind in a launch or XML
+    file, is neither found nor extra (the benchmark counts such sites apart).
+    """
+    name = path.rsplit("/", 1)[-1]
+    suffix = "." + name.rsplit(".", 1)[-1] if "." in name else ""
+    if suffix in (".yaml", ".yml") and "launch" not in name:
+        return False
+    configuration = suffix in (".xml", ".launch", ".test", ".yaml", ".yml") or (
+        suffix == ".py" and "launch" in name
+    )
+    return not (configuration and KIND_CATEGORY.get(kind) == "parameter")
+
+
 def _split(text: str) -> tuple[str, ...]:
     return tuple(part for part in text.split(";") if part)
 

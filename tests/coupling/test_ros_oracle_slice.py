@@ -7,8 +7,9 @@ copied, without the ``.in``, into one workspace that ``archmetrics scan --by lin
 reported sites of ``ros*`` packs must be exactly the rows (file, and line within
 ``[line - 2, end]``), each of the row's kind, each named as the row says when the name is
 given statically (and never named wrongly when it is not), each communication site with the
-row's message, service or action type. ``ros_endpoint`` (ros_adapter.py) is the one place
-that reads a site's JSON.
+row's message, service or action type. Parameter values in parameter and launch files are not
+labelled (``judged``). ``ros_endpoint`` (ros_adapter.py) is the one place that reads a site's
+JSON.
 """
 
 from __future__ import annotations
@@ -22,14 +23,14 @@ import pytest
 from archmetrics.cli import main
 from archmetrics.coupling import load_rule_packs
 from tests.coupling.ros_adapter import KIND_CATEGORY, is_ros_site, kind_family, ros_endpoint
-from tests.coupling.ros_rows import NAMED_STATIC, Row, match_sites, parse_rows
+from tests.coupling.ros_rows import NAMED_STATIC, Row, judged, match_sites, parse_rows
 
 if not any(pack.name.startswith("ros") for pack in load_rule_packs().packs):
     pytest.skip("no ROS rule pack (ros1, ros2) is loaded yet", allow_module_level=True)
 
 CASES = Path(__file__).resolve().parent / "ros_cases"
 ROWS = parse_rows((CASES / "cases.sites").read_text(encoding="utf-8"), "cases.sites")
-NAMES = sorted({row.file.split("/", 1)[0] for row in ROWS})
+NAMES = sorted(path.name for path in CASES.iterdir() if path.is_dir())
 
 Site = Mapping[str, object]
 
@@ -47,7 +48,11 @@ def reported(tmp_path_factory: pytest.TempPathFactory) -> list[Site]:
     assert main([*argv, str(root)]) in (0, 1)
     document = json.loads(out.read_text(encoding="utf-8"))
     sites = [site for element in document["elements"] for site in element["link_sites"]]
-    return [site for site in sites if is_ros_site(site)]
+    return [
+        site
+        for site in sites
+        if is_ros_site(site) and judged(str(site["path"]), ros_endpoint(site)[0])
+    ]
 
 
 def _where(row: Row) -> str:

@@ -20,6 +20,7 @@ from tests.coupling.ros_rows import (
     NAMED_STATIC,
     Row,
     is_test_path,
+    judged,
     match_sites,
     parse_rows,
 )
@@ -116,6 +117,26 @@ def test_test_files(path: str, test: bool) -> None:
     assert is_test_path(path) is test
 
 
+@pytest.mark.parametrize(
+    ("path", "kind", "expected"),
+    [
+        ("pkg/src/node.cpp", "param-declare", True),
+        ("pkg/config/params.yaml", "param-get", False),
+        ("pkg/config/params.yaml", "publisher", False),
+        ("pkg/launch/robot.launch.yaml", "launch-node", True),
+        ("pkg/launch/robot.launch.yaml", "param-set", False),
+        ("pkg/launch/bringup_launch.py", "param-get", False),
+        ("pkg/launch/bringup_launch.py", "launch-component", True),
+        ("pkg/test/amcl.xml", "param-get", False),
+        ("pkg/scripts/relay", "param-get", True),
+    ],
+)
+def test_parameter_values_in_configuration_files_are_not_judged(
+    path: str, kind: str, expected: bool
+) -> None:
+    assert judged(path, kind) is expected
+
+
 def test_every_kind_has_one_category_and_a_family() -> None:
     kinds = [kind for group in CATEGORIES.values() for kind in group]
     assert len(kinds) == len(set(kinds)) == len(KIND_CATEGORY)
@@ -169,6 +190,9 @@ def test_a_site_becomes_kind_name_and_type() -> None:
     unresolved = {**site, "rule": "ros1/py-subscriber", "status": "unresolved", "type": None}
     assert ros_endpoint(unresolved) == ("subscription", None, None)
     assert ros_endpoint({"rule": "ros2/py-spin", "role": "receive"})[0] == "subscription"
+    export = {"rule": "ros2/cpp-pluginlib-export", "endpoint": "demo::Talker", "status": "local"}
+    assert ros_endpoint(export) == ("plugin-export", "demo::Talker", None)
+    assert ros_endpoint({**export, "endpoint": "plugin:nav2/Navfn"})[1] == "nav2/Navfn"
 
 
 def test_the_slice_table_names_lines_of_its_snippets() -> None:
