@@ -264,7 +264,7 @@ def run(repos: Iterable[Repo], args: argparse.Namespace) -> None:
                  if is_ros_site(s) and repo.in_scope(str(s["path"]))]  # fmt: skip
         kept = [s for s in sites if judged(str(s["path"]), ros_endpoint(s)[0])]
         rows = [row for row in repo.rows if repo.in_scope(row.file)]
-        match = match_sites(rows, kept, lambda site: ros_endpoint(site)[0])
+        match = match_sites(rows, kept, ros_endpoint)
         report_repo(repo, match, len(sites) - len(kept), args.markdown)
         if args.details:
             details(match)

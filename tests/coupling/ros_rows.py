@@ -7,7 +7,8 @@ test_ros_oracle_slice.py) share this format: ``|``-separated cells under the hea
 (benchmarks/ros_oracle/README.md says what every column means). A reported site matches a row
 of the same file when its line lies in ``[line - LINE_SLACK, end]`` (a tool may report the
 statement's first line rather than the callee's); each row and each site is matched at most
-once, nearest line first, and among equally near ones a site whose kind agrees with the row's.
+once, nearest line first, and among equally near ones a site whose kind (then name) agrees
+with the row's.
 """
 
 from __future__ import annotations
@@ -114,21 +115,26 @@ def parse_rows(text: str, source: str) -> list[Row]:
     return rows
 
 
-def _disagree(
-    row: Row, site: Mapping[str, object], kind_of: Callable[[Mapping[str, object]], str] | None
-) -> bool:
-    return kind_of is not None and kind_of(site) != kind_family(row.kind)
+Endpoint = Callable[[Mapping[str, object]], tuple[str, str | None, str | None]]
+
+
+def _disagree(row: Row, site: Mapping[str, object], endpoint_of: Endpoint | None) -> int:
+    if endpoint_of is None:
+        return 0
+    kind, name, _ = endpoint_of(site)
+    return 2 * (kind != kind_family(row.kind)) + (bool(row.names) and not row.accepts(name))
 
 
 def match_sites(
     rows: Iterable[Row],
     sites: Iterable[Mapping[str, object]],
-    kind_of: Callable[[Mapping[str, object]], str] | None = None,
+    endpoint_of: Endpoint | None = None,
 ) -> Match:
     """Pair rows and reported sites of one tree by file and line (LINE_SLACK, nearest first).
 
-    ``kind_of`` gives a site's kind family (``ros_endpoint(site)[0]``); it only decides between
-    equally near pairs, e.g. a subscription and the publish call in its callback on one line.
+    ``endpoint_of`` (``ros_endpoint``) only decides between equally near pairs: first those whose
+    kinds agree, then those whose names do -- a subscription and the publish call in its
+    callback on one line, two parameters read on one line.
     """
     by_file: dict[str, list[Mapping[str, object]]] = {}
     for site in sites:
@@ -138,7 +144,7 @@ def match_sites(
         candidates = by_file.get(file, [])
         file_rows = [row for row in rows if row.file == file]
         options = sorted(
-            (abs(int(str(site["line"])) - row.line), _disagree(row, site, kind_of), i, j)
+            (abs(int(str(site["line"])) - row.line), _disagree(row, site, endpoint_of), i, j)
             for i, row in enumerate(file_rows)
             for j, site in enumerate(candidates)
             if row.line - LINE_SLACK <= int(str(site["line"])) <= row.end

@@ -63,7 +63,7 @@ def _where(row: Row) -> str:
 def test_each_site_of_the_case_is_found_and_nothing_else(case: str, reported: list[Site]) -> None:
     rows = [row for row in ROWS if row.file.startswith(f"{case}/")]
     sites = [site for site in reported if str(site["path"]).startswith(f"{case}/")]
-    match = match_sites(rows, sites, lambda site: ros_endpoint(site)[0])
+    match = match_sites(rows, sites, ros_endpoint)
     assert [_where(row) for row in match.missed] == [], "sites not found"
     assert [(s["path"], s["line"], s["rule"]) for s in match.extra] == [], "sites not in the table"
     for row, site in match.pairs:
@@ -88,5 +88,5 @@ def test_each_site_of_the_case_is_found_and_nothing_else(case: str, reported: li
 )
 def test_the_two_ends_of_one_name_meet(file: str, line: int, reported: list[Site]) -> None:
     [row] = [row for row in ROWS if (row.file, row.line) == (file, line)]
-    [(_, site)] = match_sites([row], reported, lambda site: ros_endpoint(site)[0]).pairs
+    [(_, site)] = match_sites([row], reported, ros_endpoint).pairs
     assert site["status"] == "resolved", _where(row)

@@ -95,11 +95,25 @@ def test_equally_near_sites_pair_with_the_row_of_their_kind() -> None:
         {"path": "r.py", "line": 10, "kind": "publish"},
         {"path": "r.py", "line": 10, "kind": "subscription"},
     ]
-    match = match_sites(rows, sites, lambda site: str(site["kind"]))
+    match = match_sites(rows, sites, lambda site: (str(site["kind"]), None, None))
     assert sorted((row.kind, site["kind"]) for row, site in match.pairs) == [
         ("publish", "publish"),
         ("subscription", "subscription"),
     ]
+
+
+def test_two_sites_of_one_kind_on_a_line_pair_by_name() -> None:
+    rows = parse_rows(
+        _rows(
+            "m.py|86|86|param-get|~warning_percentage||literal|w||",
+            "m.py|86|86|param-get|~window||literal|w||",
+        ),
+        "demo.sites",
+    )
+    sites = [{"path": "m.py", "line": 86, "name": n} for n in ("~window", "~warning_percentage")]
+    match = match_sites(rows, sites, lambda site: ("param-get", str(site["name"]), None))
+    assert all(row.names == (site["name"],) for row, site in match.pairs)
+    assert len(match.pairs) == 2
 
 
 @pytest.mark.parametrize(
@@ -175,7 +189,7 @@ def _consistent(rows: list[Row], sites: str) -> None:
             assert row.names, f"{where}: a static name must be written down"
         if communication or row.kind.startswith("launch"):
             assert all(n.startswith(("/", "~")) for n in row.names + row.launch_names), where
-    keys = [(row.file, row.line, row.kind) for row in rows]
+    keys = [(row.file, row.line, row.kind, row.names) for row in rows]
     assert len(keys) == len(set(keys)), f"{sites}: a site is listed twice"
 
 
