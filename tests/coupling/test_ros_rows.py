@@ -159,7 +159,8 @@ def test_every_kind_has_one_category_and_a_family() -> None:
 
 def _oracle() -> list[tuple[str, str]]:
     document = tomllib.loads((ORACLE / "repos.toml").read_text(encoding="utf-8"))
-    return [(entry["name"], entry["sites"]) for entry in document["repo"]]
+    entries = [*document["repo"], *document["deb"]]
+    return [(entry["name"], entry["sites"]) for entry in entries]
 
 
 def test_the_oracle_pins_every_repository_to_a_commit() -> None:
@@ -171,6 +172,15 @@ def test_the_oracle_pins_every_repository_to_a_commit() -> None:
         assert re.fullmatch(r"[0-9a-f]{40}", entry["commit"]), entry["name"]
         assert (ORACLE / entry["sites"]).is_file(), entry["sites"]
     assert sorted(p.name for p in ORACLE.glob("*.sites")) == sorted(s for _, s in _oracle())
+
+
+def test_the_debian_packages_are_pinned_by_version_and_checksum() -> None:
+    document = tomllib.loads((ORACLE / "repos.toml").read_text(encoding="utf-8"))
+    for entry in document["deb"]:
+        assert entry["packages"] and entry["paths"], entry["name"]
+        for package in entry["packages"]:
+            assert package["version"] and package["arch"] in ("all", "amd64"), package["name"]
+            assert re.fullmatch(r"[0-9a-f]{64}", package["sha256"]), package["name"]
 
 
 @pytest.mark.parametrize(("repo", "sites"), _oracle(), ids=[name for name, _ in _oracle()])
