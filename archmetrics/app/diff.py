@@ -19,6 +19,7 @@ from archmetrics.app.coupling import (
     rule_set,
 )
 from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.app.settings import gate_origins
 from archmetrics.app.tree import Side, begin_delta, side_of
 from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
@@ -440,4 +441,5 @@ def run_diff(
     gates = options.gates
     report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
     failures = check_gates(gates, report.summaries())
-    return DiffReport(report.base, report.head, change, warnings, report.gates, failures)
+    origins = gate_origins(request.settings, checkout.root)
+    return replace(report, failures=failures, origins=origins)

@@ -98,6 +98,22 @@ class GateFailure:
         return f"gate failed: {self.gate.text} ({read})"
 
 
+@dataclass(frozen=True, slots=True)
+class GateOrigin:
+    """Where a gate is written: a configuration file (relative to the repository's top) and
+    the line that holds the gate's text. A gate given on the command line has none."""
+
+    gate: str
+    path: str
+    line: int
+
+
+def measured_values(gate: Gate, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
+    """Every condition's value on these summaries, by ``FIELD(LOCATION)`` (None: undefined),
+    whether the gate failed or not: what the JSON's gate entries carry."""
+    return {c.name: c.value(summaries) for group in gate.groups for c in group}
+
+
 def check_gates(gates: Iterable[Gate], summaries: Mapping[str, Summary]) -> tuple[GateFailure, ...]:
     """The gates that fail on these summaries (keys: base, new, framework, total)."""
     failures = []

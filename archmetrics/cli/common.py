@@ -132,9 +132,14 @@ def _with_excludes(
     load: Callable[[Path, tuple[str, ...]], Settings], path: Path, args: argparse.Namespace | None
 ) -> Settings:
     try:
-        return load(path, tuple(getattr(args, "exclude", None) or ()))
+        settings = load(path, tuple(getattr(args, "exclude", None) or ()))
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
+    for notice in settings.notices:
+        warn(notice)
+    if args is not None:
+        _detail(args, f"configuration: {settings.source}")
+    return settings
 
 
 def emit(text: str, output: Path | None) -> None:

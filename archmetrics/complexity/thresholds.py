@@ -133,15 +133,51 @@ class ThresholdFailure:
         numbers = ", ".join(f"{f} = {unit.values[f]}" for f in self.threshold.fields)
         return f"gate failed: {self.threshold.text}: {where}{unit.name} ({numbers})"
 
+    @property
+    def excess(self) -> float:
+        """How far past its limit the unit lies: for the first condition of the first group
+        that fails, (value − limit) / |limit| for ``>``/``>=`` and (limit − value) / |limit|
+        for ``<``/``<=`` (|limit| at least 1); 0 for ``==``/``!=``. Worst first sorts by it."""
+        for group in self.threshold.groups:
+            if all(c.holds(self.unit.values) for c in group):
+                first = group[0]
+                return past_limit(first.op, float(self.unit.values[first.field]), first.limit)
+        return 0.0
+
+
+def past_limit(op: str, value: float, limit: float) -> float:
+    """How far ``value`` lies past ``limit`` in the direction ``op`` fails, relative to the
+    limit (at least 1 in magnitude): what orders offenders worst first."""
+    scale = max(abs(limit), 1.0)
+    if op in (">", ">="):
+        return (value - limit) / scale
+    if op in ("<", "<="):
+        return (limit - value) / scale
+    return 0.0
+
+
+def worst_first(failures: Iterable[ThresholdFailure]) -> tuple[ThresholdFailure, ...]:
+    """``failures`` with the furthest past its limit first (:attr:`ThresholdFailure.excess`),
+    ties by file, line and name: what every report lists first, so no cap hides the worst."""
+    return tuple(
+        sorted(
+            failures,
+            key=lambda f: (-f.excess, f.unit.path or "", f.unit.line or 0, f.unit.name),
+        )
+    )
+
 
 def check_thresholds(
     thresholds: Iterable[Threshold], units: Mapping[str, Sequence[Unit]]
 ) -> tuple[ThresholdFailure, ...]:
-    """Every unit that fails a threshold, threshold by threshold, units in the order given
-    (``units``: the units of each kind)."""
+    """Every unit that fails a threshold, threshold by threshold, each threshold's units
+    worst first (:func:`worst_first`; ``units``: the units of each kind)."""
     return tuple(
-        ThresholdFailure(threshold, unit)
+        failure
         for threshold in thresholds
-        for unit in units.get(threshold.unit, ())
-        if threshold.fails(unit.values)
+        for failure in worst_first(
+            ThresholdFailure(threshold, unit)
+            for unit in units.get(threshold.unit, ())
+            if threshold.fails(unit.values)
+        )
     )

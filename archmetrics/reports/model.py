@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from archmetrics.changeset.accuracy import ChangeAccuracy
-from archmetrics.changeset.gates import GateFailure
+from archmetrics.changeset.gates import GateFailure, GateOrigin
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
@@ -80,6 +80,11 @@ class DiffReport:
     warnings: tuple[ParseWarning, ...] = ()
     gates: tuple[str, ...] = ()  # the gate expressions checked
     failures: tuple[GateFailure, ...] = ()
+    origins: tuple[GateOrigin, ...] = ()  # where the configured gates are written
+
+    def origin(self, gate: str) -> GateOrigin | None:
+        """Where ``gate`` is written, if a configuration file sets it."""
+        return next((o for o in self.origins if o.gate == gate), None)
 
     def summaries(self) -> dict[str, Summary]:
         """Per location and the total, keyed base, new, framework, total."""
@@ -169,6 +174,7 @@ class EstimateReport:
     failures: tuple[EstimateFailure, ...] = ()
     actual: DiffReport | None = None  # --actual: the change measured afterwards
     accuracy: tuple[tuple[str, ChangeAccuracy], ...] = ()  # per architecture, against it
+    plan_path: str | None = None  # the plan file relative to the repository (None: outside)
 
     def compare(self) -> CompareReport:
         """The architectures as series side by side (what series and compare render)."""
