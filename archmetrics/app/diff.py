@@ -67,6 +67,7 @@ class DiffRequest:
     gates: tuple[str, ...] = ()  # --fail-on, after the configured ones
     jobs: int = 0
     dynamic_pre_zero: bool = False
+    base_label: str = ""  # how reports name the base (``A...B``), when not ``base`` itself
 
 
 @dataclass(frozen=True, slots=True)
@@ -439,7 +440,9 @@ def run_diff(
     options = options or diff_options(request, checkout.root)  # a bad gate fails before work
     change, warnings = measure_change(request, progress, cache, checkout, options)
     gates = options.gates
-    report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
+    label = request.base_label or request.base
+    report = DiffReport(label, request.head, change, warnings, tuple(g.text for g in gates))
     failures = check_gates(gates, report.summaries())
     origins = gate_origins(request.settings, checkout.root)
-    return replace(report, failures=failures, origins=origins)
+    commits = (checkout.commit_id(request.base), checkout.commit_id(request.head))
+    return replace(report, failures=failures, origins=origins, commits=commits)

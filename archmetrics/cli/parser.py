@@ -157,10 +157,22 @@ def build_parser() -> argparse.ArgumentParser:
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
-    diff.add_argument("--base", default="HEAD", help="REV, EMPTY, WORKTREE or INDEX (default HEAD)")
     diff.add_argument(
-        "--head", default="WORKTREE", help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
+        "--base",
+        default="HEAD",
+        help="REV, EMPTY, WORKTREE or INDEX (default HEAD); A...B compares B with the merge"
+        " base of A and B, as git diff A...B does (a pull request's own changes); A..B is A"
+        " against B",
     )
+    diff.add_argument(
+        "--head", default=None, help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
+    )
+    diff.add_argument(
+        "--merge-base",
+        action="store_true",
+        help="compare --head with the merge base of --base and --head (as --base A...B)",
+    )
+    diff.add_argument("files", nargs="*", metavar="FILE", help=argparse.SUPPRESS)
     diff.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
     diff.add_argument(
         "--from-pre-commit",

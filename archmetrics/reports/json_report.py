@@ -5,11 +5,14 @@ from __future__ import annotations
 import heapq
 import json
 import re
+from collections.abc import Mapping
 from operator import itemgetter
 from typing import Any
 
+from archmetrics import __version__
 from archmetrics.changeset.accuracy import Accuracy
-from archmetrics.changeset.model import ChangeReport
+from archmetrics.changeset.gates import measured_values, parse_gate
+from archmetrics.changeset.model import ChangeReport, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
@@ -157,16 +160,28 @@ def render_scan(report: ScanReport) -> str:
 
 def diff_dict(report: DiffReport) -> dict[str, Any]:
     failed = {f.gate.text for f in report.failures}
+    summaries = report.summaries()
     return {
         "schema": DIFF_SCHEMA,
         "base": report.base,
         "head": report.head,
-        "locations": {name: s.to_dict() for name, s in report.summaries().items()},
+        "locations": {name: s.to_dict() for name, s in summaries.items()},
         "elements": element_records(report.change),
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
-        "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+        "gates": [
+            {"gate": g, "failed": g in failed, "values": _gate_values(g, summaries)}
+            for g in report.gates
+        ],
+        "base_commit": report.commits[0],
+        "head_commit": report.commits[1],
+        "tool": {"name": "archmetrics", "version": __version__},
     }
+
+
+def _gate_values(text: str, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
+    """What each condition of the gate ``text`` measured (``FIELD(LOCATION)``: value)."""
+    return measured_values(parse_gate(text), summaries)
 
 
 def element_records(change: ChangeReport) -> list[dict[str, Any]]:

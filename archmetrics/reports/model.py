@@ -81,6 +81,7 @@ class DiffReport:
     gates: tuple[str, ...] = ()  # the gate expressions checked
     failures: tuple[GateFailure, ...] = ()
     origins: tuple[GateOrigin, ...] = ()  # where the configured gates are written
+    commits: tuple[str | None, str | None] = (None, None)  # base's and head's commit ids
 
     def origin(self, gate: str) -> GateOrigin | None:
         """Where ``gate`` is written, if a configuration file sets it."""
