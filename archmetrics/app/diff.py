@@ -343,6 +343,9 @@ def measure_snapshots(
     progress.phase("comparing the changed files")
     change = _compare(pre, post, moved, options, progress, cache)
     progress.stop()
+    if options.rules.rules or options.rules.exclude:
+        paths = (row.path for side in (pre, post) for row in side.state.rows)
+        change = replace(change, unmatched=options.rules.unmatched(paths))
     return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
 
 

@@ -240,6 +240,7 @@ class ChangeReport:
     computed: tuple[ElementChange, ...]  # sorted by element name
     excluded: tuple[ExcludedFile, ...]
     plain: PlainLike | None = None
+    unmatched: tuple[str, ...] = ()  # location and exclude globs that matched no file
 
     @cached_property
     def elements(self) -> tuple[ElementChange, ...]:

@@ -23,7 +23,9 @@ from archmetrics.cli.common import (
     settings_for,
     shown_progress,
     split,
+    warn,
 )
+from archmetrics.reports.diff_rows import unmatched_glob
 from archmetrics.reports.formats import (
     Grouping,
     OutputFormat,
@@ -272,6 +274,8 @@ def diff_command(args: argparse.Namespace) -> int:
         progress.phase("writing the report")
         text = render_diff(report, fmt, args.max_rows)
     emit(text, args.output)
+    for glob in report.change.unmatched:
+        warn(unmatched_glob(glob))
     stage = Stage(f"{label}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))

@@ -133,3 +133,11 @@ def compare_rows(compare: CompareReport) -> list[list[str]]:
         for series_rows in per_series.values():
             rows.extend(r for r in series_rows if r[2] == location)
     return rows
+
+
+def unmatched_glob(glob: str) -> str:
+    """The warning for a location or exclude glob that matched no file."""
+    return (
+        f"the glob {glob!r} matched no file archmetrics measures, before or after"
+        " (a typo, or quotes kept around it?)"
+    )

@@ -136,6 +136,7 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
         more = len(excluded) - _SHOWN_EXCLUDED
         bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
+    bullets += [f"- warning: {diff_rows.unmatched_glob(g)}" for g in report.change.unmatched]
     tail = ["\n".join(bullets) + "\n"] if bullets else []
     changed = report.change.changed()
     if changed:

@@ -157,6 +157,7 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
+    lines += [f"warning: {diff_rows.unmatched_glob(g)}" for g in report.change.unmatched]
     lines += [str(f) for f in report.failures]
     return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
 

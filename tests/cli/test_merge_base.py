@@ -118,3 +118,14 @@ def test_what_cannot_be_a_merge_base_is_refused_with_the_reason(
         "origin/main and HEAD: no merge base in this shallow clone; fetch the history first"
         " (git fetch --deepen=200, or --unshallow; fetch-depth: 0 in CI)"
     ) in err
+
+
+def test_a_location_glob_that_matches_no_file_is_named(
+    behind: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["diff", "-C", str(behind.root), "--base", "main...HEAD", "-q", "--format", "markdown"]
+    assert main([*argv, "--new", '"a.py"', "--framework", "a.py"]) == 0
+    out, err = capsys.readouterr()
+    said = "the glob '\"a.py\"' matched no file archmetrics measures, before or after"
+    assert f"archmetrics: warning: {said}" in err and said in out
+    assert "'a.py' matched" not in err  # the same glob without its quotes matches
