@@ -21,11 +21,13 @@ from archmetrics.app.coupling import (
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.settings import gate_origins
 from archmetrics.app.tree import Side, begin_delta, side_of
+from archmetrics.app.unit_gates import split_gates, touched_units
 from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.files import exclusion, pair_files
-from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.changeset.gates import Gate, check_gates
+from archmetrics.changeset.locations import Location
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
@@ -36,7 +38,10 @@ from archmetrics.changeset.statement_diff import (
     diff_files,
     same_statements,
 )
+from archmetrics.changeset.touched import touched
 from archmetrics.changeset.unchanged import Unchanged
+from archmetrics.complexity.baseline import Baseline
+from archmetrics.complexity.thresholds import Threshold, check_units
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, group_elements
 from archmetrics.coupling.rules import RuleSet
@@ -68,6 +73,7 @@ class DiffRequest:
     jobs: int = 0
     dynamic_pre_zero: bool = False
     base_label: str = ""  # how reports name the base (``A...B``), when not ``base`` itself
+    baseline: Baseline | None = None  # offenders already known (--baseline FILE)
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,7 +82,8 @@ class DiffOptions:
     of a diff (and each stage of a series) reads these, never the two sources again."""
 
     rules: LocationRules
-    gates: tuple[Gate, ...]
+    gates: tuple[Gate, ...]  # on the change's summaries (cost(new) > 20)
+    unit_gates: tuple[Threshold, ...]  # on the functions and files it touches (app/unit_gates)
     languages: tuple[tuple[str, str], ...]  # file ending -> language
     limits: WorkerLimits
     jobs: int
@@ -90,9 +97,11 @@ def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
     from there). A bad gate or rule pack fails here, before any work."""
     settings = request.settings
     limits = worker_limits(settings.limits, settings.macros)
+    gates, unit_gates = split_gates((*settings.gates, *request.gates))
     return DiffOptions(
         rules=location_rules(request),
-        gates=tuple(parse_gate(g) for g in (*settings.gates, *request.gates)),
+        gates=gates,
+        unit_gates=unit_gates,
         languages=settings.languages,
         # generated files count nowhere unless asked for: the first lines that say so suffice
         limits=replace(limits, skip_generated=not settings.include_generated),
@@ -346,6 +355,11 @@ def measure_snapshots(
     if options.rules.rules or options.rules.exclude:
         paths = (row.path for side in (pre, post) for row in side.state.rows)
         change = replace(change, unmatched=options.rules.unmatched(paths))
+    if options.unit_gates:  # what a function or file gate checks
+        change = replace(change, touched=touched(change, post.known))
+    broken = _unparsed(pre, post, options.rules)
+    if broken:
+        change = change.with_unparsed(broken)
     return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
 
 
@@ -385,6 +399,20 @@ def _compare(
         values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
         unchanged=unchanged,
     )  # fmt: skip
+
+
+def _unparsed(pre: Side, post: Side, rules: LocationRules) -> dict[Location, int]:
+    """Per location, the files the change touched (new or changed) that cannot be parsed
+    after it and no exclude glob leaves out."""
+    found: dict[Location, int] = {}
+    for row in post.state.rows:
+        if row.parsed or rules.is_excluded(row.path) is not None:
+            continue
+        before = pre.by_path.get(row.path)
+        if before is None or (before.blob, before.language) != (row.blob, row.language):
+            location = rules.location_of(row.path)
+            found[location] = found.get(location, 0) + 1
+    return found
 
 
 def _differing(pre: Side, post: Side) -> frozenset[str]:
@@ -444,8 +472,13 @@ def run_diff(
     change, warnings = measure_change(request, progress, cache, checkout, options)
     gates = options.gates
     label = request.base_label or request.base
-    report = DiffReport(label, request.head, change, warnings, tuple(g.text for g in gates))
+    texts = (*(g.text for g in gates), *(t.text for t in options.unit_gates))
+    report = DiffReport(label, request.head, change, warnings, texts)
     failures = check_gates(gates, report.summaries())
+    checked = check_units(options.unit_gates, touched_units(change), request.baseline)
     origins = gate_origins(request.settings, checkout.root)
     commits = (checkout.commit_id(request.base), checkout.commit_id(request.head))
-    return replace(report, failures=failures, origins=origins, commits=commits)
+    return replace(
+        report, failures=failures, offenders=checked.failures, suppressed=checked.suppressed,
+        baselined=checked.baselined, origins=origins, commits=commits,
+    )  # fmt: skip

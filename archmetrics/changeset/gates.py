@@ -20,8 +20,17 @@ from archmetrics.complexity.thresholds import COMPARISON, OPERATORS, or_of_ands
 _CONDITION = re.compile(
     r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*" + COMPARISON
 )
-NUMERIC_FIELDS = tuple(f for f in SUMMARY_FIELDS if f != "notes")
+NUMERIC_FIELDS = (*(f for f in SUMMARY_FIELDS if f != "notes"), "unparsed")
 LOCATIONS = ("base", "new", "framework", "total")
+
+
+_UNIT = re.compile(r"\(\s*(?:function|file)\s*\)")
+
+
+def is_unit_gate(text: str) -> bool:
+    """Whether ``text`` gates the functions or files a change touches (``vg(function) >
+    15``, a threshold: complexity/thresholds.py) rather than a location's summary."""
+    return _UNIT.search(text) is not None
 
 
 class GateError(ValueError):

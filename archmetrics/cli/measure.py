@@ -12,6 +12,7 @@ from archmetrics.app.progress import NoProgress
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
 from archmetrics.app.settings import repo_root
+from archmetrics.cli.baseline import load_baseline
 from archmetrics.cli.common import (
     EXIT_OK,
     UsageError,
@@ -25,6 +26,7 @@ from archmetrics.cli.common import (
     split,
     warn,
 )
+from archmetrics.reports.charts import charts_missing
 from archmetrics.reports.diff_rows import unmatched_glob
 from archmetrics.reports.formats import (
     Grouping,
@@ -48,6 +50,9 @@ def check_chart(args: argparse.Namespace) -> str | None:
     fmt: str = args.chart.suffix.lower().lstrip(".")
     if fmt not in ("png", "svg"):
         raise UsageError(f"{args.chart}: --chart needs a .png or .svg file")
+    missing = charts_missing()
+    if missing is not None:
+        raise UsageError(f"--chart: {missing}")
     folder = args.chart.parent
     if not folder.is_dir():
         raise UsageError(f"{args.chart}: --chart: no folder {folder}")
@@ -98,12 +103,16 @@ def scan_command(args: argparse.Namespace) -> int:
         jobs=args.jobs,
         plain_directory=args.sample,
         gates=tuple(args.fail_on),
+        baseline=load_baseline(args.baseline),
     )
     with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
         report = run_scan(request, progress, cache)
         progress.phase("writing the report")
         text = render_scan(report, fmt, Grouping(args.by))
     emit(text, args.output)
+    if args.output is not None or fmt not in (OutputFormat.TABLE, OutputFormat.MARKDOWN):
+        for note in report.notes:  # (a table or Markdown on stdout shows them)
+            print(f"archmetrics: note: {note}", file=sys.stderr)
     return gate_status(report.failures, args)
 
 
@@ -219,6 +228,7 @@ def diff_request(
         gates=tuple(args.fail_on),
         jobs=args.jobs,
         dynamic_pre_zero=args.dynamic_pre_zero,
+        baseline=load_baseline(getattr(args, "baseline", None)),
     )
 
 
@@ -279,4 +289,4 @@ def diff_command(args: argparse.Namespace) -> int:
     stage = Stage(f"{label}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))
-    return gate_status(report.failures, args)
+    return gate_status(report.failed, args)

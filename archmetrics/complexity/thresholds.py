@@ -14,6 +14,7 @@ import operator
 import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple, Protocol
 
 OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
     ">=": operator.ge,
@@ -112,12 +113,18 @@ def _condition(text: str, part: str, example: str) -> tuple[str, Condition]:
 
 @dataclass(frozen=True, slots=True)
 class Unit:
-    """One function, file, element or the total: what names it, where it is, its numbers."""
+    """One function, file, element or the total: what names it, where it is, its numbers,
+    and the fields a reviewer's comment exempts it from (a function's ``suppressed``)."""
 
     name: str
     path: str | None
     line: int | None
     values: Mapping[str, int]
+    suppressed: tuple[str, ...] = ()
+
+    def exempt(self, fields: Iterable[str]) -> bool:
+        """Whether a suppression comment exempts this unit from every one of ``fields``."""
+        return all(f in self.suppressed or "*" in self.suppressed for f in fields)
 
 
 @dataclass(frozen=True, slots=True)
@@ -164,6 +171,40 @@ def worst_first(failures: Iterable[ThresholdFailure]) -> tuple[ThresholdFailure,
             failures,
             key=lambda f: (-f.excess, f.unit.path or "", f.unit.line or 0, f.unit.name),
         )
+    )
+
+
+class Checked(NamedTuple):
+    """What checking thresholds found: the units that fail, and those that would have
+    failed but a suppression comment exempts or the baseline already knows (listed, never
+    hidden)."""
+
+    failures: tuple[ThresholdFailure, ...] = ()
+    suppressed: tuple[ThresholdFailure, ...] = ()
+    baselined: tuple[ThresholdFailure, ...] = ()
+
+
+class Known(Protocol):
+    """A baseline: which of a threshold's failures it already knows (complexity/baseline.py)."""
+
+    def known(self, failures: Sequence[ThresholdFailure]) -> frozenset[int]: ...
+
+
+def check_units(
+    thresholds: Iterable[Threshold],
+    units: Mapping[str, Sequence[Unit]],
+    baseline: Known | None = None,
+) -> Checked:
+    """:func:`check_thresholds`, then set apart the failures a suppression comment exempts
+    (every field the threshold reads) and, of the rest, those ``baseline`` knows."""
+    failures = check_thresholds(thresholds, units)
+    suppressed = tuple(f for f in failures if f.unit.exempt(f.threshold.fields))
+    left = [f for f in failures if not f.unit.exempt(f.threshold.fields)]
+    known = baseline.known(left) if baseline is not None else frozenset()
+    return Checked(
+        tuple(f for i, f in enumerate(left) if i not in known),
+        suppressed,
+        tuple(f for i, f in enumerate(left) if i in known),
     )
 
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 from archmetrics.changeset.gates import GateFailure
 from archmetrics.changeset.model import ElementChange
-from archmetrics.complexity import FileMetrics
+from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.reports.model import CompareReport, DiffReport, EstimateReport, ScanReport
 
@@ -85,10 +85,19 @@ def top_file(files: Sequence[FileMetrics], field: str) -> tuple[FileMetrics, str
     return top, words.get(field) or f"its file with the {_NAMES[field]}"
 
 
-def _scan_finding(report: ScanReport, failure: ThresholdFailure, by_path: dict[str, FileMetrics],
-                  element_files: dict[str, tuple[str, ...]]) -> Finding:  # fmt: skip
+def _scan_finding(
+    report: ScanReport,
+    failure: ThresholdFailure,
+    by_path: dict[str, FileMetrics],
+    element_files: dict[str, tuple[str, ...]],
+    stage: str = "",
+) -> Finding:
     unit, kind = failure.unit, failure.threshold.unit
-    message = str(failure).removeprefix("gate failed: ")
+    numbers = ", ".join(f"{f} = {unit.values[f]}" for f in failure.threshold.fields)
+    # where it is: the finding's location says (a file's name is its path)
+    said = numbers if kind == "file" else f"{unit.name} ({numbers})"
+    message = f"{failure.threshold.text}: {said}"
+    message = f"{stage}: {message}" if stage else message
     fields = failure.threshold.fields
     path, line, placed = unit.path, unit.line or 1, ""
     if kind in ("element", "total"):
@@ -97,9 +106,15 @@ def _scan_finding(report: ScanReport, failure: ThresholdFailure, by_path: dict[s
         whole = f"element {unit.name}" if kind == "element" else "the whole tree"
         path, line = (top[0].path, 1) if top else (None, 1)
         placed = f"{whole}; shown at {top[1]}" if top else f"{whole}; nothing measured"
-    identity = f"{unit.name}\0{unit.path or '.'}"
+    identity = f"{unit.name}\0{unit.path or '.'}" + (f"\0{stage}" if stage else "")
     return Finding(failure.threshold.text, message, path, line, identity, placed,
                    failure.excess, fields)  # fmt: skip
+
+
+def unit_findings(failures: Iterable[ThresholdFailure], stage: str = "") -> list[Finding]:
+    """A diff's touched functions and files over a unit gate, each where it is."""
+    empty = ScanReport("", "", (), (), Totals(0, 0, 0, 0, 0, 0, 0))
+    return [_scan_finding(empty, f, {}, {}, stage) for f in failures]
 
 
 def scan_findings(report: ScanReport) -> list[Finding]:
@@ -158,8 +173,8 @@ def _gates(failures: Iterable[GateFailure], report: DiffReport, stage: str = "")
 
 
 def diff_findings(report: DiffReport) -> list[Finding]:
-    """Every failed gate of the change."""
-    return _gates(report.failures, report)
+    """Every failed gate of the change, and every touched unit over a unit gate."""
+    return _gates(report.failures, report) + unit_findings(report.offenders)
 
 
 def compare_findings(report: CompareReport) -> list[Finding]:
@@ -169,6 +184,7 @@ def compare_findings(report: CompareReport) -> list[Finding]:
         for stage in series.stages:
             name = f"{approach} {stage.label}".strip()
             found += _gates(stage.report.failures, stage.report, name)
+            found += unit_findings(stage.report.offenders, name)
     return found
 
 

@@ -32,6 +32,9 @@ class ScanReport:
     excluded: tuple[ExcludedFile, ...] = ()  # left out by the configuration's `exclude`
     gates: tuple[str, ...] = ()  # the thresholds checked (--fail-on)
     failures: tuple[ThresholdFailure, ...] = ()  # every unit that failed one
+    suppressed: tuple[ThresholdFailure, ...] = ()  # would fail: a comment exempts them
+    baselined: tuple[ThresholdFailure, ...] = ()  # would fail: the baseline knows them
+    notes: tuple[str, ...] = ()  # what the reader should know: nothing to measure
 
     def element_rows(self) -> list[ElementRow]:
         """Per element: its files, summed λ, SLOC and v_g, and its coupling."""
@@ -80,8 +83,16 @@ class DiffReport:
     warnings: tuple[ParseWarning, ...] = ()
     gates: tuple[str, ...] = ()  # the gate expressions checked
     failures: tuple[GateFailure, ...] = ()
+    offenders: tuple[ThresholdFailure, ...] = ()  # touched functions, files over a unit gate
+    suppressed: tuple[ThresholdFailure, ...] = ()  # would fail: a comment exempts them
+    baselined: tuple[ThresholdFailure, ...] = ()  # would fail: the baseline knows them
     origins: tuple[GateOrigin, ...] = ()  # where the configured gates are written
     commits: tuple[str | None, str | None] = (None, None)  # base's and head's commit ids
+
+    @property
+    def failed(self) -> tuple[GateFailure | ThresholdFailure, ...]:
+        """Every failure: the location gates', then the touched units' (worst first)."""
+        return (*self.failures, *self.offenders)
 
     def origin(self, gate: str) -> GateOrigin | None:
         """Where ``gate`` is written, if a configuration file sets it."""
@@ -108,8 +119,8 @@ class SeriesReport:
     stages: tuple[Stage, ...]
 
     @property
-    def failures(self) -> tuple[GateFailure, ...]:
-        return tuple(f for s in self.stages for f in s.report.failures)
+    def failures(self) -> tuple[GateFailure | ThresholdFailure, ...]:
+        return tuple(f for s in self.stages for f in s.report.failed)
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,7 +130,7 @@ class CompareReport:
     series: tuple[tuple[str, SeriesReport], ...]
 
     @property
-    def failures(self) -> tuple[GateFailure, ...]:
+    def failures(self) -> tuple[GateFailure | ThresholdFailure, ...]:
         return tuple(f for _, s in self.series for f in s.failures)
 
 

@@ -43,6 +43,7 @@ SUMMARY_KEYS = {
     "scaled_delta_vg",
     "cost",
     "notes",
+    "unparsed",
 }
 
 
