@@ -133,8 +133,9 @@ def docs_epilog() -> str:
     root = docs_root()
     where = f"installed in {root}" if root is not None else "missing from this installation"
     return (
-        f"Docs: {where}: metrics.md (what is counted), json.md (the JSON contract), ci.md"
-        " (CI, pre-commit, code scanning); `archmetrics docs [TOPIC]` lists them or prints one."
+        f"Docs: {where}: glossary.md (what each number means), metrics.md (what is counted),"
+        " json.md (the JSON contract), ci.md (CI, pre-commit, code scanning, choosing gates);"
+        " `archmetrics docs [TOPIC]` lists them or prints one."
     )
 
 
