@@ -21,13 +21,12 @@ from archmetrics.app.coupling import (
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.settings import gate_origins
 from archmetrics.app.tree import Side, begin_delta, side_of
-from archmetrics.app.unit_gates import split_gates, touched_units
+from archmetrics.app.unit_gates import for_gates, split_gates, touched_units
 from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.files import exclusion, pair_files
 from archmetrics.changeset.gates import Gate, check_gates
-from archmetrics.changeset.locations import Location
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
@@ -38,7 +37,6 @@ from archmetrics.changeset.statement_diff import (
     diff_files,
     same_statements,
 )
-from archmetrics.changeset.touched import touched
 from archmetrics.changeset.unchanged import Unchanged
 from archmetrics.complexity.baseline import Baseline
 from archmetrics.complexity.thresholds import Threshold, check_units
@@ -352,14 +350,7 @@ def measure_snapshots(
     progress.phase("comparing the changed files")
     change = _compare(pre, post, moved, options, progress, cache)
     progress.stop()
-    if options.rules.rules or options.rules.exclude:
-        paths = (row.path for side in (pre, post) for row in side.state.rows)
-        change = replace(change, unmatched=options.rules.unmatched(paths))
-    if options.unit_gates:  # what a function or file gate checks
-        change = replace(change, touched=touched(change, post.known))
-    broken = _unparsed(pre, post, options.rules)
-    if broken:
-        change = change.with_unparsed(broken)
+    change = for_gates(change, pre, post, options.rules, bool(options.unit_gates))
     return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
 
 
@@ -399,20 +390,6 @@ def _compare(
         values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
         unchanged=unchanged,
     )  # fmt: skip
-
-
-def _unparsed(pre: Side, post: Side, rules: LocationRules) -> dict[Location, int]:
-    """Per location, the files the change touched (new or changed) that cannot be parsed
-    after it and no exclude glob leaves out."""
-    found: dict[Location, int] = {}
-    for row in post.state.rows:
-        if row.parsed or rules.is_excluded(row.path) is not None:
-            continue
-        before = pre.by_path.get(row.path)
-        if before is None or (before.blob, before.language) != (row.blob, row.language):
-            location = rules.location_of(row.path)
-            found[location] = found.get(location, 0) + 1
-    return found
 
 
 def _differing(pre: Side, post: Side) -> frozenset[str]:

@@ -38,6 +38,7 @@ from archmetrics.reports.formats import (
 )
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources.checkout import Checkout, open_checkout
+from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import resolve_path
 
 
@@ -201,8 +202,8 @@ def check_hook_files(files: list[str], checkout: Checkout) -> None:
     and without --from-ref/--to-ref nothing says which."""
     if not files:
         return
-    staged = checkout.staged_paths()
-    others = [path for path in files if path not in staged]
+    staged = checkout.staged_paths()  # as reports name them: escaped as git escapes them
+    others = [path for path in files if quote_path(path) not in staged]
     if others:
         raise UsageError(
             f"pre-commit ran the hook on files, not on a change ({others[0]} is not staged:"
