@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import shlex
+import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -69,3 +70,15 @@ def test_the_commands_of_the_page_parse() -> None:
             build_parser().parse_args(argv)
         except SystemExit as error:
             pytest.fail(f"{command}: exit {error.code}")
+
+
+def test_no_page_pins_a_tag_that_does_not_exist() -> None:
+    """archmetrics has no release tags: the pages pin a commit (`@COMMIT`), never a `@v0.1.0`
+    a reader cannot fetch."""
+    tags = subprocess.run(
+        ["git", "-C", str(ROOT), "tag", "--list"], capture_output=True, text=True
+    ).stdout.split()
+    pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
+    for page in pages:
+        for tag in re.findall(r"archmetrics@(v[0-9][\w.]*)", page.read_text(encoding="utf-8")):
+            assert tag in tags, f"{page.name} pins {tag}, which is no tag of archmetrics"
