@@ -159,7 +159,14 @@ def estimate(
 
 
 def _frame(table: Table) -> pd.DataFrame:
-    import pandas as pd  # 0.3 s to import: only when a frame is asked for
+    try:
+        import pandas as pd  # 0.3 s to import: only when a frame is asked for
+    except ModuleNotFoundError as error:
+        raise ModuleNotFoundError(
+            "archmetrics.api returns pandas DataFrames, and pandas is not installed:"
+            " pip install 'archmetrics[api]'",
+            name="pandas",
+        ) from error
 
     return pd.DataFrame.from_records(table.rows, columns=list(table.columns))
 

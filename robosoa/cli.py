@@ -14,6 +14,7 @@ from typing import Any
 from robosoa import commands, logs
 from robosoa.cli_input import UsageError
 from robosoa.errors import RobosoaError
+from robosoa.extras import missing
 from robosoa.location import Limits
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
@@ -169,6 +170,12 @@ def _guard(run: Callable[[], int]) -> int:
     """Run a command; user-facing failures become one line on stderr and an exit status."""
     try:
         return run()
+    except ModuleNotFoundError as exc:  # pyzmq or lxml: the runtime extra
+        said = missing(exc, "this command")
+        if said is None:
+            raise
+        print(f"robosoa: error: {said}", file=sys.stderr)
+        return 2
     except UsageError as exc:
         print(f"robosoa: error: {exc}", file=sys.stderr)
         return 2

@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
-from archmetrics.cli import docs, estimate, measure, study
+from archmetrics.cli import baseline, docs, estimate, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
@@ -33,6 +33,7 @@ from archmetrics.study.manifest import ManifestError
 
 COMMANDS = {
     "scan": measure.scan_command,
+    "baseline": baseline.baseline_command,
     "diff": measure.diff_command,
     "series": measure.series_command,
     "compare": measure.compare_command,
@@ -56,6 +57,7 @@ CANNOT_MEASURE = (
     ManifestError,
     CacheError,
     PlanError,
+    baseline.BaselineError,
 )
 
 
@@ -82,8 +84,8 @@ def few_collections() -> Iterator[None]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    settle_format(args)
     try:
+        settle_format(args)
         if getattr(args, "jobs", 0) < 0:
             raise UsageError("--jobs must be 0 or more")
         if (getattr(args, "max_rows", None) or 0) < 0:

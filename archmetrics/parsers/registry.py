@@ -9,6 +9,7 @@ from importlib import metadata
 from archmetrics.facts import ConfigFormat, FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import text
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, too_large
+from archmetrics.parsers.suppressions import with_suppressions
 
 ParseFunction = Callable[[str, str], FileFacts]
 """(path, decoded source) -> facts. Decoding and binary checks happen before it is called."""
@@ -168,7 +169,7 @@ def parse_source(
             warnings=(ParseWarning(path, 1, "binary file with a source ending; not measured"),),
         )
     source, decode_warning = text.decode(path, data)
-    facts = table.spec(language).read(path, source, limits)
+    facts = with_suppressions(table.spec(language).read(path, source, limits), source)
     extra: list[ParseWarning] = [decode_warning] if decode_warning else []
     generated = facts.generated or text.declares_generated(source)
     if not extra and generated == facts.generated:

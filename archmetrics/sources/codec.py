@@ -46,7 +46,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 8
+FORMAT = 9
 BODY_LINES = 3  # call sites, statements, bindings
 
 _new = tuple.__new__
@@ -93,6 +93,7 @@ def encode(facts: FileFacts) -> bytes:
                 f.statements,
                 [[d.kind, d.line] for d in f.decisions],
                 list(f.parameters),
+                list(f.suppressed),
             ]
             for f in facts.functions
         ],
@@ -316,9 +317,10 @@ def _decode(
                         tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
                         st,
                         tuple([intern(p) for p in ps]),
+                        tuple(sp),
                     ),
                 )
-                for n, q, a, b, st, ds, ps in functions
+                for n, q, a, b, st, ds, ps, sp in functions
             ]
         ),
         classes=tuple([Class(n, q, spans[a, b], k) for n, q, a, b, k in classes]),
