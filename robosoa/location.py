@@ -150,8 +150,9 @@ class LocationService:
 
     def __init__(self, registry: Registry, peer_factory: PeerFactory | None = None,
                  hello: Mapping[str, Any] | None = None, name: str = "location",
-                 limits: Limits = Limits()) -> None:
+                 limits: Limits = Limits(), refuse_federate: str = "") -> None:
         self.registry = registry
+        self.refuse_federate = refuse_federate  # why a client's federate is refused; "": not
         self.name = name
         self.limits = limits
         self.counter = Counter("requests", "location")  # count; errors: refused requests
@@ -181,9 +182,9 @@ class LocationService:
         seen = {info.instance for info in found}
         for address, remote in self._ask_peers(name):
             for info in remote[: self.limits.max_per_peer]:
-                if info.instance not in seen:
+                if info.instance not in seen:  # a peer's word on keys is never passed on
                     seen.add(info.instance)
-                    found.append(replace(info, origin=info.origin or address))
+                    found.append(replace(info, origin=info.origin or address, key=""))
         return found
 
     def _ask_peers(self, name: str | None) -> list[tuple[str, list[ServiceInfo]]]:
@@ -222,6 +223,8 @@ class LocationService:
                                     bool(request.get("local", False)))
                 return {"services": [i.to_dict() for i in infos]}
             if op == "federate":
+                if self.refuse_federate:
+                    return {"error": f"federate refused: {self.refuse_federate}"}
                 self.federate(str(request["address"]))
                 return {"ok": True}
             if op == "hello":

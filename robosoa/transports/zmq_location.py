@@ -37,6 +37,7 @@ log = logging.getLogger("robosoa.location")
 PEER_TIMEOUT = 0.3  # seconds a federated lookup may take before the peer is skipped
 LINK_HEARTBEAT, LINK_TIMEOUT = 1.0, 3.0  # ZMTP heartbeats, as BusOptions' defaults
 ANNOUNCE = b"a:\0"  # channel of "the publishers changed" announcements
+NO_CURVE = "a federated location service's key cannot be given"
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,6 +54,7 @@ class LocationConfig:
     limits: Limits = field(default_factory=Limits)  # registrations, TTLs, federation
     curve_secret: str = ""  # this service's certificate (NAME.key_secret); "" = no CURVE
     curve_allow: str = ""  # folder of the public certificates allowed on the bus
+    accept_federate: bool = False  # clients may add federation peers (no CURVE only)
 
 
 def _wild(endpoint: str) -> str:
@@ -70,6 +72,16 @@ def announce_bind(config: LocationConfig) -> str:
     else:
         derived = f"tcp://{where}:{port + 1}"
     return _wild(config.announce or derived)
+
+
+def _refusal(config: LocationConfig, curve: bool) -> str:
+    """Why a client's ``federate`` is refused ("" when it is accepted)."""
+    if curve:
+        return f"federation over CURVE is not available ({NO_CURVE})"
+    if not config.accept_federate:
+        return ("only the operator adds federation peers (robosoa location --federate "
+                "ENDPOINT, or --accept-federate to take them from clients)")
+    return ""
 
 
 def _peer_of(frame: zmq.Frame) -> str:
@@ -91,9 +103,9 @@ class LocationServer:
     def __init__(self, config: LocationConfig) -> None:
         self.config = config
         self.curve = curve.load(config.curve_secret, config.curve_allow, "", server=True)
-        if self.curve is not None and config.federate:
-            raise RobosoaError("--federate is not available with CURVE yet (a federated "
-                               "location service's key cannot be given)")
+        if self.curve is not None and (config.federate or config.accept_federate):
+            flag = "--federate" if config.federate else "--accept-federate"
+            raise RobosoaError(f"{flag} is not available with CURVE yet ({NO_CURVE})")
         self._ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
         self._auth = self.curve.authenticator(self._ctx) if self.curve is not None else None
         self._sockets: list[zmq.Socket[bytes]] = []
@@ -107,8 +119,10 @@ class LocationServer:
         self.announce = self._last(self._announce)
         hello = {"transport": "zmq", "announce": self.announce}
         registry = Registry(default_ttl=config.ttl, limits=config.limits)
-        self.service = LocationService(registry, self._peer, hello, name=self.endpoint,
-                                       limits=config.limits)
+        peers = None if self.curve is not None else self._peer  # never asked in plaintext
+        self.service = LocationService(registry, peers, hello, name=self.endpoint,
+                                       limits=config.limits, refuse_federate=_refusal(config,
+                                       self.curve is not None))
         for address in config.federate:
             self.service.federate(address)
         self._stop = threading.Event()
@@ -136,6 +150,8 @@ class LocationServer:
         return str(sock.getsockopt_string(zmq.LAST_ENDPOINT))
 
     def _peer(self, address: str) -> Peer:
+        if self.curve is not None:  # a plaintext socket must never leave a CURVE bus
+            raise RobosoaError(f"federation over CURVE is not available ({NO_CURVE})")
         ctx = self._ctx
         check_endpoint(address)
         request = {"op": "lookup", "local": True}
