@@ -172,18 +172,27 @@ class LocationService:
             self._peers[address] = self._peer_factory(address)
             log.info("federated", extra={"peer": address})
 
+    def needs_peers(self, request: Mapping[str, Any]) -> bool:
+        """Whether answering ``request`` means asking federated peers (and so waiting up to
+        ``federation_timeout``): a lookup, not local, of a name not known here or of all."""
+        if request.get("op") != "lookup" or request.get("local") or not self._peers:
+            return False
+        name = request.get("name")
+        return name is None or not select(self.registry.entries(), str(name), None)
+
     def lookup(self, name: str | None, local: bool = False) -> list[ServiceInfo]:
         """Local entries; peers are asked only for names not known locally (and for listings),
         all at once and for ``federation_timeout`` seconds in total; a peer that failed or
-        did not answer in time is skipped for ``PEER_BACKOFF`` seconds."""
+        did not answer in time is dropped from this answer, counted, and skipped for
+        ``PEER_BACKOFF`` seconds. A peer's entries of other names are ignored."""
         found = select(self.registry.entries(), name, None)
         if local or (found and name is not None):
             return found
         seen = {info.instance for info in found}
         for address, remote in self._ask_peers(name):
             for info in remote[: self.limits.max_per_peer]:
-                if info.instance not in seen:  # a peer's word on keys is never passed on
-                    seen.add(info.instance)
+                if info.instance not in seen and name in (None, info.name):
+                    seen.add(info.instance)  # a peer's word on keys is never passed on
                     found.append(replace(info, origin=info.origin or address, key=""))
         return found
 
@@ -196,6 +205,7 @@ class LocationService:
         for address, outcome in ask_all(calls, self.limits.federation_timeout).items():
             if isinstance(outcome, Exception):  # a dead peer must not break local lookups
                 self._backoff[address] = self._clock() + PEER_BACKOFF
+                self.counter.drop("late" if isinstance(outcome, TimeoutError) else "bad-reply")
                 log.warning("federated lookup failed", extra={"peer": address,
                                                               "error": str(outcome)})
             else:

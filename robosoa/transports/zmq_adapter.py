@@ -161,6 +161,8 @@ class ZmqAdapter(ProtocolAdapter):
         if not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
         rid = next(self._rids)
+        if request.get("op") == "lookup":  # the reply must fit our frame limit
+            request = {**request, "max_bytes": self.options.max_message}
         raw = json.dumps({**request, "rid": rid}).encode()
         deadline = time.monotonic() + timeout
         dealers = self._live_dealers()

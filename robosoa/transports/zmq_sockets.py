@@ -17,8 +17,8 @@ from typing import Any
 import zmq
 
 from robosoa.blobs import MAX_BLOBS
-from robosoa.errors import InvalidMessage, RobosoaError
-from robosoa.wire import MAX_MESSAGE, load_object
+from robosoa.errors import RobosoaError
+from robosoa.wire import MAX_MESSAGE
 
 
 def split_endpoint(endpoint: str) -> tuple[str, str, int]:
@@ -157,10 +157,12 @@ def public(endpoint: str, location: str) -> str:
     return endpoint
 
 
-def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
-                     request: dict[str, Any], timeout: float,
-                     max_message: int = MAX_MESSAGE) -> dict[str, Any]:
-    """One-shot location-protocol request on a fresh socket (used for federation peers)."""
+def location_frame(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
+                   request: dict[str, Any], timeout: float,
+                   max_message: int = MAX_MESSAGE) -> bytes:
+    """One-shot location-protocol request on a fresh socket (used for federation peers):
+    the reply's first frame; TimeoutError when no reply of at most ``max_message`` bytes a
+    frame comes within ``timeout`` (ZeroMQ drops a larger one unread)."""
     sock = ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
     limit_input(sock, max_message)
@@ -168,11 +170,9 @@ def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
         sock.connect(endpoint)
         sock.send(json.dumps(request).encode())
         if not sock.poll(int(timeout * 1000), zmq.POLLIN):
-            raise RobosoaError(f"location service at {endpoint} did not answer")
-        try:
-            return load_object(sock.recv(), max_message)
-        except InvalidMessage as exc:
-            raise RobosoaError(f"location service at {endpoint} sent a bad reply: {exc}") from None
+            raise TimeoutError(f"location service at {endpoint} did not answer within "
+                               f"{timeout:g}s")
+        return sock.recv()
     finally:
         sock.close()
 

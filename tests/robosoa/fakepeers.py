@@ -85,3 +85,36 @@ class FakePeers:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+class Listings:
+    """A client keeping ``depth`` federated listings (``lookup`` of every name) in flight
+    at a location service until stopped; counts the answers and their largest size."""
+
+    def __init__(self, endpoint: str, depth: int) -> None:
+        self._ctx: zmq.Context[zmq.Socket[bytes]] = zmq.Context()
+        self._endpoint, self._depth = endpoint, depth
+        self._stop = threading.Event()
+        self.answered = 0
+        self.largest = 0  # bytes of the largest reply
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        sock = self._ctx.socket(zmq.DEALER)
+        sock.setsockopt(zmq.LINGER, 0)
+        sock.connect(self._endpoint)
+        listing = json.dumps({"op": "lookup", "name": None}).encode()
+        for _ in range(self._depth):
+            sock.send(listing)
+        while not self._stop.is_set():
+            if sock.poll(100):
+                self.largest = max(self.largest, len(sock.recv()))
+                self.answered += 1
+                sock.send(listing)
+        sock.close(0)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=10)
+        self._ctx.term()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -134,3 +135,11 @@ def test_peers_that_miss_the_deadline_are_backed_off() -> None:
     start = time.monotonic()
     assert service.lookup("a") == [] and service.lookup("b") == []
     assert time.monotonic() - start < 1.0 and calls == ["a"]
+
+
+def test_an_entry_as_a_dict_has_every_field() -> None:
+    info = ServiceInfo.from_dict(entry("a", 2.5, group="g", idempotent=["op"], pid=7))
+    expected = dataclasses.asdict(info) | {"operations": ["op"], "idempotent": ["op"]}
+    assert info.to_dict() == expected
+    assert list(info.to_dict()) == [f.name for f in dataclasses.fields(ServiceInfo)]
+    assert ServiceInfo.from_dict(info.to_dict()) == info
