@@ -24,6 +24,7 @@ from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
 from robosoa.transports import zmq_curve as curve
 from robosoa.transports.zmq_federation import PEER_REPLY, FederationPool, encode_reply
+from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard
 from robosoa.transports.zmq_sockets import (
     Waker,
     check_endpoint,
@@ -129,6 +130,7 @@ class LocationServer:
         self._sockets: list[zmq.Socket[bytes]] = []
         self._waker = Waker(self._ctx)  # federation workers' replies are ready
         self._federation = FederationPool(self._waker.wake)
+        self._guard = Guard()
         try:  # a bind that fails (bad address, port taken) releases what was bound before
             self._router = self._socket(zmq.ROUTER, _wild(config.bind))
             self._announce = self._socket(zmq.PUB, announce_bind(config))
@@ -140,6 +142,10 @@ class LocationServer:
         hello = {"transport": "zmq", "announce": self.announce}
         registry = Registry(default_ttl=config.ttl, limits=config.limits)
         peers = None if self.curve is not None else self._peer  # never asked in plaintext
+        # a request is one frame: no connection may hold more than two
+        self._watch = self._guard.watch(self._router, 2 * config.max_message,
+                                        FRAMING if self.curve is None else CURVE_FRAMING,
+                                        lambda peer: self.service.counter.drop("budget"))
         self.service = LocationService(registry, peers, hello, name=self.endpoint,
                                        limits=config.limits, refuse_federate=_refusal(config,
                                        self.curve is not None))
@@ -258,6 +264,9 @@ class LocationServer:
                 ready = dict(poller.poll(200))
                 if self._router in ready:
                     frames = self._router.recv_multipart(copy=False)
+                    if self._watch is not None:
+                        self._watch.took(b"", sum(len(f) for f in frames[1:]),
+                                         len(frames) - 1, frames[0])
                     try:
                         self._answer(frames)
                     except Exception:  # last line of defence: no request ends the service
@@ -273,6 +282,7 @@ class LocationServer:
             self._release()
 
     def _release(self) -> None:
+        self._guard.close()
         self._federation.close()
         self._waker.close()
         for sock in self._sockets:

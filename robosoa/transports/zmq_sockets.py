@@ -18,7 +18,7 @@ import zmq
 
 from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import RobosoaError
-from robosoa.wire import MAX_MESSAGE
+from robosoa.wire import MAX_MESSAGE, LimitExceeded
 
 
 def split_endpoint(endpoint: str) -> tuple[str, str, int]:
@@ -77,30 +77,41 @@ def send_frames(sock: zmq.Socket[bytes], frames: Sequence[bytes], flags: int = 0
         sock.send(frames[n], flags | _SNDMORE if n < last else flags, copy=False)
 
 
-def recv_rest(sock: zmq.Socket[bytes], first: bytes,
-              limit: int = MAX_BLOBS + 1) -> list[bytes]:
-    """``first`` and the other frames of the message it began (already arrived, whole).
+def recv_rest(sock: zmq.Socket[bytes], first: bytes, limit: int = MAX_BLOBS + 1,
+              total: int = MAX_MESSAGE) -> list[bytes]:
+    """``first`` and the other frames of the message it began (already arrived, whole),
+    read one by one.
 
     Frames past ``limit`` are read and thrown away, so a message of too many frames comes
-    back as ``limit + 1`` frames, which the decoder refuses.
+    back as ``limit + 1`` frames, which the decoder refuses. Once the frames hold more than
+    ``total`` bytes the rest are read without a copy and thrown away, and LimitExceeded says
+    so: at most ``total`` bytes and one frame of a message are ever copied out of libzmq
+    (which held the whole message before its first frame could be read: see zmq_guard).
     """
     frames = [first]
+    size = len(first)
     while sock.getsockopt(_RCVMORE):
+        if size > total:
+            sock.recv(copy=False)
+            continue
         frame = sock.recv()
+        size += len(frame)
         if len(frames) <= limit:
             frames.append(frame)
+    if size > total:
+        raise LimitExceeded(f"message of more than {total} bytes in its frames")
     return frames
 
 
-def recv_message(sock: zmq.Socket[bytes], flags: int = 0,
-                 limit: int = MAX_BLOBS + 1) -> list[bytes]:
+def recv_message(sock: zmq.Socket[bytes], flags: int = 0, limit: int = MAX_BLOBS + 1,
+                 total: int = MAX_MESSAGE) -> list[bytes]:
     """One whole message, as :func:`recv_rest` gives it. The first frame is taken as a
     ``zmq.Frame``, whose ``more`` flag answers what ``getsockopt(RCVMORE)`` would (that
     costs about 0.75 us in pyzmq, the Frame about 0.35 us): a one-frame message, the common
     case on a subscriber, asks the socket nothing more."""
     first = sock.recv(flags, copy=False)
     head = first.bytes
-    return recv_rest(sock, head, limit) if first.more else [head]
+    return recv_rest(sock, head, limit, total) if first.more else [head]
 
 
 def keepalive(sock: zmq.Socket[bytes], heartbeat: float, timeout: float) -> None:
