@@ -11,6 +11,7 @@ the ROUTER socket) through a queue and a wake-up.
 from __future__ import annotations
 
 import json
+import logging
 import queue
 import threading
 from collections.abc import Callable, Mapping
@@ -18,6 +19,8 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import orjson
+
+log = logging.getLogger("robosoa.location")
 
 WORKERS = 2  # federated lookups under way at once
 PENDING = 8  # federated lookups waiting for a worker; more are answered locally (busy)
@@ -47,6 +50,8 @@ class FederationPool:
     def _run(self, identity: bytes, job: Callable[[], bytes]) -> None:
         try:
             self._done.put((identity, job()))
+        except Exception:  # the asker gets no answer (it times out); the service goes on
+            log.exception("federated lookup failed")
         finally:
             with self._lock:
                 self._open -= 1

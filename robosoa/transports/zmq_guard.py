@@ -45,6 +45,13 @@ ALLOWANCE = 256  # bytes a second a connection may receive that nobody takes (ZM
 FRAMING = 9  # bytes of ZMTP around one frame (its flags and size)
 CURVE_FRAMING = 9 + 33  # around one CURVE-encrypted frame (MESSAGE command, nonce, box)
 HANDSHAKE = 4096  # bytes of greeting and handshake a connection starts with
+FLOOR = 16 * 1024 * 1024  # no budget is smaller: bursts of small messages are not cut
+
+
+def budget(message: int) -> int:
+    """The budget of a connection whose messages have at most ``message`` bytes: two whole
+    messages ahead of the application, and never less than ``FLOOR``."""
+    return max(2 * message, FLOOR)
 _RECEIVED = 128  # offset of tcpi_bytes_received in Linux's struct tcp_info (since 4.1)
 _INFO = 136
 _EVENTS = int(zmq.EVENT_ACCEPTED | zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED

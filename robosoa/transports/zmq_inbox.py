@@ -11,7 +11,7 @@ from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
 from robosoa.transports.zmq_curve import Curve
-from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard
+from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard, budget
 from robosoa.transports.zmq_sockets import (
     bind_provider,
     keepalive,
@@ -54,9 +54,9 @@ class ZmqInbox(Inbox):
                                       options.provider_bind,
                                       options.advertise_host)
         self._bound = str(self._router.getsockopt_string(zmq.LAST_ENDPOINT))
-        budget = 2 * options.total  # at most two whole messages ahead of the provider
         self._watch = None if guard is None else guard.watch(
-            self._router, budget, FRAMING if curve is None else CURVE_FRAMING, cut)
+            self._router, budget(options.total), FRAMING if curve is None else CURVE_FRAMING,
+            cut)
         self._token = uuid.uuid4().bytes
         self._timeout = -2
 

@@ -24,7 +24,7 @@ from robosoa.errors import InvalidMessage, RobosoaError
 from robosoa.location import Limits, LocationService, Peer, Registry, ServiceInfo
 from robosoa.transports import zmq_curve as curve
 from robosoa.transports.zmq_federation import PEER_REPLY, FederationPool, encode_reply
-from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard
+from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard, budget
 from robosoa.transports.zmq_sockets import (
     Waker,
     check_endpoint,
@@ -142,8 +142,7 @@ class LocationServer:
         hello = {"transport": "zmq", "announce": self.announce}
         registry = Registry(default_ttl=config.ttl, limits=config.limits)
         peers = None if self.curve is not None else self._peer  # never asked in plaintext
-        # a request is one frame: no connection may hold more than two
-        self._watch = self._guard.watch(self._router, 2 * config.max_message,
+        self._watch = self._guard.watch(self._router, budget(config.max_message),
                                         FRAMING if self.curve is None else CURVE_FRAMING,
                                         lambda peer: self.service.counter.drop("budget"))
         self.service = LocationService(registry, peers, hello, name=self.endpoint,

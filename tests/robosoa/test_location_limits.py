@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import time
 
@@ -17,6 +18,7 @@ from robosoa.location import (
     RegistryFull,
     ServiceInfo,
 )
+from robosoa.transports.zmq_federation import encode_reply
 
 
 def entry(instance: str, ttl: object = 0.0, **extra: object) -> dict[str, object]:
@@ -143,3 +145,17 @@ def test_an_entry_as_a_dict_has_every_field() -> None:
     assert info.to_dict() == expected
     assert list(info.to_dict()) == [f.name for f in dataclasses.fields(ServiceInfo)]
     assert ServiceInfo.from_dict(info.to_dict()) == info
+
+
+def test_a_lookup_reply_is_cut_to_its_limit() -> None:
+    services = [ServiceInfo.from_dict(entry(f"i{n}", pid=n)).to_dict() for n in range(100)]
+    whole, left = encode_reply({"services": services}, 7, 10**6)
+    assert left == 0 and json.loads(whole) == {"services": services, "rid": 7}
+    for limit in (len(whole) - 1, len(whole) // 2, 300):
+        frame, left = encode_reply({"services": services}, 7, limit)
+        data = json.loads(frame)
+        assert len(frame) <= limit and 0 < left == data["truncated"]
+        assert data["services"] == services[: 100 - left] and data["rid"] == 7
+    past_64_bits, _ = encode_reply({"services": [{"pid": 10**30}]}, 10**40, 1000)
+    assert json.loads(past_64_bits) == {"services": [{"pid": 10**30}], "rid": 10**40}
+    assert json.loads(encode_reply({"error": "no"}, "r", 1000)[0]) == {"error": "no", "rid": "r"}

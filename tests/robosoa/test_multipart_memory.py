@@ -12,18 +12,22 @@ provider keeps serving. Frames past ``max_total`` are refused as they are read."
 from __future__ import annotations
 
 import json
+import shutil
 import textwrap
 import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import pytest
 import zmq
 
 import robosoa
 from robosoa.transports.zmq_guard import SUPPORTED
+from robosoa.transports.zmq_guard import budget as guard_budget
 from robosoa.transports.zmq_outlet import META
 from tests.robosoa.conftest import FAST
-from tests.robosoa.procs import PYTHON, Proc, free_port
+from tests.robosoa.procs import PYTHON, Proc, free_port, start_location
+from tests.robosoa.test_cli import run
 from tests.robosoa.test_hostile_peers import robosoa_stats
 from tests.robosoa.util import eventually, raw_publisher
 
@@ -116,7 +120,7 @@ def cuts(url: str, role: str, key: str) -> int:
 def test_a_3000_frame_message_cannot_hold_gigabytes(zmq_url: str, name: str,
                                                     ctx: zmq.Context[zmq.Socket[bytes]]) -> None:
     options = {"max_message": MIB, "inbox_size": 1, "hwm": 1}  # a message: 1 MiB in all
-    budget = 2 * MIB  # two whole messages ahead of the provider
+    budget = guard_budget(MIB)  # two whole messages ahead of the provider, at least 16 MiB
     proc, endpoint, pid = provider(zmq_url, name, **options)
     try:
         before = peak(pid)
@@ -160,7 +164,7 @@ def test_the_location_service_is_bounded_too(ctx: zmq.Context[zmq.Socket[bytes]]
     try:
         pid = proc.popen.pid
         before = peak(pid)
-        bound = 4 * 2 * MIB + OVERSHOOT  # its budget: two frames (a request is one)
+        bound = 4 * guard_budget(MIB) + OVERSHOOT  # a request is one frame
         attacker = flood(ctx, bind, 3000, MIB)
         settled(proc, pid, before + bound, lambda: cuts(url, "location", "requests"))
         attacker.close(0)
@@ -220,3 +224,47 @@ def test_consumers_and_subscribers_refuse_frames_past_max_total(
         assert figures[("wire", "broadcast")].errors == 1
         pub.close(0)
     router.close(0)
+
+
+@pytest.fixture(scope="module")
+def keys(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("keys")
+    done = run("keys", str(folder), "location", "alice")
+    assert done.returncode == 0, done.stderr
+    (folder / "allow").mkdir()
+    for who in ("location", "alice"):
+        shutil.copy(folder / f"{who}.key", folder / "allow")
+    return folder
+
+
+@pytest.mark.parametrize("curve", [False, True])
+def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) -> None:
+    """The guard's count of what was taken must keep up with what arrived: 150 requests and
+    200 one-way messages of 900 KiB (315 MB through one connection, 19 times its 16 MiB
+    budget), the one-way ones in bursts of four, none cut, with and without CURVE."""
+    secure = ["--curve-secret", str(keys / "location.key_secret"),
+              "--curve-allow", str(keys / "allow")] if curve else []
+    proc, url = start_location(f"tcp://127.0.0.1:{free_port()}",
+                               "--announce", f"tcp://127.0.0.1:{free_port()}", *secure)
+    options: dict[str, object] = {**FAST, "max_message": MIB}
+    if curve:
+        options |= {"curve_secret": str(keys / "alice.key_secret"),
+                    "curve_allow": str(keys / "allow")}
+    blob = b"y" * (900 * 1024)
+    try:
+        with robosoa.connect(url, **options) as provider, \
+                robosoa.connect(url, **options) as consumer:
+            seen: list[int] = []
+            provider.provide("sink", {"size": lambda d: {"n": len(d)},
+                                      "note": lambda d: seen.append(len(d))})
+            for n in range(200):
+                if n % 4:
+                    assert consumer.request("sink", "size", {"d": blob}) == {"n": len(blob)}
+                else:
+                    for _ in range(4):  # 3.6 MB ahead of the provider, and a request
+                        consumer.send("sink", "note", {"d": blob})
+            eventually(lambda: len(seen) == 200, timeout=30)
+            drops = {(f.role, f.key): dict(f.drops) for f in provider.stats()}
+            assert drops.get(("wire", "inbox"), {}).get("budget", 0) == 0
+    finally:
+        proc.stop()
