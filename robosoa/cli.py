@@ -71,6 +71,9 @@ def _server_commands(sub: Any) -> None:
     p.add_argument("--ttl", type=float, default=3.0, help="default entry TTL in seconds")
     p.add_argument("--federate", action="append", metavar="ENDPOINT",
                    help="also answer for services of this location service (repeatable)")
+    p.add_argument("--accept-federate", action="store_true",
+                   help="let clients add federation peers (anyone who can reach this "
+                   "service; refused with CURVE)")
     _location_limits(p)
     _curve(p)
     p.set_defaults(run=commands.cmd_location)
