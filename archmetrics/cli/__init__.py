@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
-from archmetrics.cli import docs, estimate, measure, study
+from archmetrics.cli import docs, estimate, history, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
@@ -36,6 +36,7 @@ COMMANDS = {
     "diff": measure.diff_command,
     "series": measure.series_command,
     "compare": measure.compare_command,
+    "history": history.history_command,
     "estimate": estimate.estimate_command,
     "replicate": study.replicate_command,
     "rules": measure.rules_command,

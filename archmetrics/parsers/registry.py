@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+import functools
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
 
@@ -89,7 +90,12 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
 )
 
 
-def _plugin_languages() -> Iterable[LanguageSpec]:
+@functools.cache
+def _plugin_languages() -> tuple[LanguageSpec, ...]:
+    """The languages plugins announce, read once per process: scanning the installed
+    distributions' entry points costs tens of milliseconds, and a history builds its
+    language table for every commit."""
+    found = []
     for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
         spec = entry.load()
         if not isinstance(spec, LanguageSpec):
@@ -97,7 +103,8 @@ def _plugin_languages() -> Iterable[LanguageSpec]:
                 f"entry point {entry.name!r} in group {ENTRY_POINT_GROUP} must be a LanguageSpec,"
                 f" got {type(spec).__name__}"
             )
-        yield spec
+        found.append(spec)
+    return tuple(found)
 
 
 @dataclass(frozen=True, slots=True)

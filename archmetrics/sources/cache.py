@@ -109,6 +109,7 @@ _HEAD = (
 )
 _BODY = "select data from bodies where blob=? and language=? and parser=?"
 _KEY = "blob=? and language=? and parser=?"
+_HAS = f"select 1 from facts where {_KEY}"
 
 
 def _read_only(path: Path) -> sqlite3.Connection:
@@ -185,6 +186,13 @@ class FactsCache:
         self.hits += 1
         self.remember(blob, facts)
         return facts
+
+    def has(self, blob: str, language: str) -> bool:
+        """Whether facts of ``blob`` in ``language`` are kept (without reading them)."""
+        key = (blob, language, self.fingerprint)
+        if not self._bodies:
+            return False
+        return self._run(lambda db: db.execute(_HAS, key).fetchone()) is not None
 
     def _forget(self, key: tuple[str, str, str]) -> None:
         self._run(lambda db: db.execute(f"delete from facts where {_KEY}", key))
