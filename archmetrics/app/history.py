@@ -131,10 +131,26 @@ class _Walker:
         self.configuration = configuration_files(options.packs)
 
     def walk(self, commits: Sequence[Commit], keys: dict[str, str]) -> dict[str, CommitStep]:
+        """Each of ``commits`` measured, in order; every step is kept in the cache as it is
+        found (in batches, and whatever ends the walk early), so none is measured twice."""
         found: dict[str, CommitStep] = {}
-        pending: list[tuple[str, bytes]] = []
+        self.pending: list[tuple[str, bytes]] = []
+        try:
+            self._walk(commits, keys, found)
+        finally:
+            self._keep()
+            self.progress.stop()
+        return found
+
+    def _keep(self) -> None:
+        if self.cache is not None and self.pending:
+            self.cache.put_totals(self.pending)
+        self.pending = []
+
+    def _walk(
+        self, commits: Sequence[Commit], keys: dict[str, str], found: dict[str, CommitStep]
+    ) -> None:
         pre: Side | None = None
-        quiet = NoProgress()
         deltas = commit_deltas(self.repo, commits)
         for start in range(0, len(commits), WINDOW):
             window = commits[start : start + WINDOW]
@@ -147,20 +163,14 @@ class _Walker:
                     pre = self._side_of_parent(commit)
                 post = self._patched(commit, pre, delta)
                 renames = post.renames if post.renames is not None else delta.renames
-                step = commit_step(compare_sides(pre, post, renames, self.options, quiet,
-                                                 self.cache))  # fmt: skip
-                found[commit.id] = step
+                change = compare_sides(pre, post, renames, self.options, NoProgress(), self.cache)
+                step = found[commit.id] = commit_step(change)
                 if self.cache is not None:
-                    pending.append((keys[commit.id], _compact(step_record(step))))
-                    if len(pending) >= KEEP_EVERY:
-                        self.cache.put_totals(pending)
-                        pending = []
+                    self.pending.append((keys[commit.id], _compact(step_record(step))))
+                    if len(self.pending) >= KEEP_EVERY:
+                        self._keep()
                 pre = post
                 self.progress.advance()
-        if self.cache is not None and pending:
-            self.cache.put_totals(pending)
-        self.progress.stop()
-        return found
 
     def _side_of_parent(self, commit: Commit) -> Side:
         """The side of ``commit``'s parent: its kept state, or built whole."""

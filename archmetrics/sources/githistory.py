@@ -66,11 +66,18 @@ def _run(repo: gitpython.Repo, args: Sequence[str], stdin: bytes | None = None) 
 
 
 def _failed(repo: gitpython.Repo, command: list[str], status: int, err: bytes) -> SourceError:
+    """git's own first ``fatal:`` line (a range it cannot read names the revision there;
+    its last lines are usage), or what :func:`explain` makes of the error."""
     from git.exc import GitCommandError
 
     from archmetrics.sources.git import explain
 
-    return explain(repo, GitCommandError(command, status, err), f"git {command[1]}")
+    error = explain(repo, GitCommandError(command, status, err), f"git {command[1]}")
+    fatal = [line for line in err.decode("utf-8", "replace").splitlines()
+             if line.startswith("fatal: ")]  # fmt: skip
+    if fatal and "shallow" not in str(error) and "partial clone" not in str(error):
+        return SourceError(f"git {command[1]}: {fatal[0].removeprefix('fatal: ')}")
+    return error
 
 
 def list_commits(repo: gitpython.Repo, which: Range) -> tuple[Commit, ...]:
