@@ -15,33 +15,31 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from archmetrics.app.collect import Selected, parse_all
 from archmetrics.app.coupling import configuration_files, packs_digest
-from archmetrics.app.diff import DiffOptions, DiffRequest, compare_sides, diff_options
+from archmetrics.app.diff import DiffOptions, DiffRequest, diff_options
+from archmetrics.app.history_walk import Walk
 from archmetrics.app.progress import NoProgress, Progress
-from archmetrics.app.tree import STATE_RECORD, Side, patched_side, side_of, whole_side
+from archmetrics.app.tree import STATE_RECORD, Side, side_of, whole_side
 from archmetrics.changeset.gates import check_gates
-from archmetrics.changeset.history import (
-    STEP_RECORD,
-    CommitStep,
-    commit_step,
-    step_from_record,
-    step_record,
-)
+from archmetrics.changeset.history import STEP_RECORD, CommitStep, step_from_record
 from archmetrics.parsers import LanguageTable
 from archmetrics.reports.model import HistoryEntry, HistoryReport
 from archmetrics.sources.cache import FactsCache, code_fingerprint
 from archmetrics.sources.checkout import Checkout, open_checkout
 from archmetrics.sources.git import Blobs, RevisionSnapshot
-from archmetrics.sources.gitdelta import Delta, Pending
+from archmetrics.sources.gitdelta import Delta
 from archmetrics.sources.githistory import Commit, Range, commit_deltas, list_commits
-from archmetrics.sources.snapshot import EmptySnapshot, SourceError, SourceFile
+from archmetrics.sources.snapshot import EmptySnapshot, Snapshot, SourceError
+
+if TYPE_CHECKING:
+    import git as gitpython
 
 DEFAULT_RANGE = Range()
-KEEP_EVERY = 200  # steps written to the cache at least this often: an interrupted run resumes
 WINDOW = 400  # commits whose new file versions are parsed together, before they are walked
 
 
@@ -92,14 +90,15 @@ def run_history(
     if cache is not None:
         kept = cache.get_totals(keys)
         for commit, key in zip(commits, keys, strict=True):
-            found = _kept(kept[key]) if key in kept else None
-            if found is not None:
-                steps[commit.id] = found
+            step = _kept(kept[key]) if key in kept else None
+            if step is not None:
+                steps[commit.id] = step
     missing = [c for c in commits if c.id not in steps]
-    walker = _Walker(checkout, options, cache, progress)
+    parsed = 0
     if missing:
         by_id = dict(zip((c.id for c in commits), keys, strict=False))
-        steps.update(walker.walk(missing, by_id))
+        measured, parsed = walk_here(checkout.repo, missing, by_id, options, cache, progress)
+        steps.update(measured)
     entries = tuple(
         HistoryEntry(c.id, c.parent, c.time, c.subject, c.merge, steps[c.id],
                      check_gates(options.gates, steps[c.id].summaries))
@@ -107,117 +106,87 @@ def run_history(
     )  # fmt: skip
     gates = tuple(g.text for g in options.gates)
     return HistoryReport(
-        str(checkout.root), request.range.spec, entries, gates, len(missing), walker.parsed
+        str(checkout.root), request.range.spec, entries, gates, len(missing), parsed
     )
 
 
-class _Walker:
-    """The commits of a history that have no kept step, measured in order."""
+class RepositoryTrees:
+    """The trees of a history read from its repository: each commit a revision; a parent's
+    side its kept state, or its tree read whole."""
 
-    def __init__(
-        self,
-        checkout: Checkout,
-        options: DiffOptions,
-        cache: FactsCache | None,
-        progress: Progress,
-    ) -> None:
-        assert checkout.repo is not None
-        self.repo = checkout.repo
+    def __init__(self, repo: gitpython.Repo, cache: FactsCache | None) -> None:
+        self.repo = repo
+        self.cache = cache
+
+    def snapshot(self, commit: Commit, delta: Delta) -> Snapshot:
+        return RevisionSnapshot(self.repo, commit.id, commit.id, commit.tree)
+
+    def parent_side(self, commit: Commit, options: DiffOptions) -> Side:
+        if commit.parent is None:
+            return whole_side(EmptySnapshot(), options, self.cache, NoProgress())
+        parent = RevisionSnapshot(self.repo, commit.parent, commit.parent, commit.parent_tree)
+        return side_of(parent, options, self.cache, NoProgress())
+
+
+class FileVersions:
+    """The file versions a range of commits adds that have a language: each parsed once,
+    before the commits that hold them are walked (or found in the facts cache)."""
+
+    def __init__(self, options: DiffOptions, cache: FactsCache | None) -> None:
         self.options = options
         self.cache = cache
-        self.progress = progress
-        self.parsed = 0
         self.table = LanguageTable.default(dict(options.languages))
         self.configuration = configuration_files(options.packs)
 
-    def walk(self, commits: Sequence[Commit], keys: dict[str, str]) -> dict[str, CommitStep]:
-        """Each of ``commits`` measured, in order; every step is kept in the cache as it is
-        found (in batches, and whatever ends the walk early), so none is measured twice."""
-        found: dict[str, CommitStep] = {}
-        self.pending: list[tuple[str, bytes]] = []
-        try:
-            self._walk(commits, keys, found)
-        finally:
-            self._keep()
-            self.progress.stop()
-        return found
+    def language(self, path: str) -> str | None:
+        return self.table.language_of(path) or self.configuration(path)
 
-    def _keep(self) -> None:
-        if self.cache is not None and self.pending:
-            self.cache.put_totals(self.pending)
-        self.pending = []
-
-    def _walk(
-        self, commits: Sequence[Commit], keys: dict[str, str], found: dict[str, CommitStep]
-    ) -> None:
-        pre: Side | None = None
-        deltas = commit_deltas(self.repo, commits)
-        for start in range(0, len(commits), WINDOW):
-            window = commits[start : start + WINDOW]
-            changes = [next(deltas) for _ in window]
-            self._parse(changes)
-            self.progress.start("measuring commits", len(commits))
-            self.progress.advance(start)
-            for commit, delta in zip(window, changes, strict=True):
-                if pre is None or getattr(pre.snapshot, "commit", None) != commit.parent:
-                    pre = self._side_of_parent(commit)
-                post = self._patched(commit, pre, delta)
-                renames = post.renames if post.renames is not None else delta.renames
-                change = compare_sides(pre, post, renames, self.options, NoProgress(), self.cache)
-                step = found[commit.id] = commit_step(change)
-                if self.cache is not None:
-                    self.pending.append((keys[commit.id], _compact(step_record(step))))
-                    if len(self.pending) >= KEEP_EVERY:
-                        self._keep()
-                pre = post
-                self.progress.advance()
-
-    def _side_of_parent(self, commit: Commit) -> Side:
-        """The side of ``commit``'s parent: its kept state, or built whole."""
-        if commit.parent is None:
-            snapshot = EmptySnapshot()
-            return whole_side(snapshot, self.options, self.cache, NoProgress())
-        parent = RevisionSnapshot(self.repo, commit.parent, commit.parent, commit.parent_tree)
-        self.progress.phase(f"reading {commit.parent[:12]}")
-        return side_of(parent, self.options, self.cache, NoProgress())
-
-    def _patched(self, commit: Commit, pre: Side, delta: Delta) -> Side:
-        snapshot = RevisionSnapshot(self.repo, commit.id, commit.id, commit.tree)
-        pending = Pending(lambda: delta, [])
-        side = patched_side(snapshot, pre, self.options, self.cache, NoProgress(), pending)
-        return side or whole_side(snapshot, self.options, self.cache, NoProgress())
-
-    def _parse(self, changes: Sequence[Delta]) -> None:
-        """Every file version ``changes`` add that has a language, parsed once (or found in
-        the cache), so that walking them reads facts only."""
-        wanted: dict[tuple[str, str], Selected] = {}
+    def wanted(self, changes: Iterable[Delta]) -> list[Selected]:
+        """The distinct (blob, language) of ``changes`` that the cache has no facts for."""
+        found: dict[tuple[str, str], Selected] = {}
         for delta in changes:
             for file in delta.changed:
-                language = self._language(file.path)
-                if language is not None and file.blob:
-                    key = (file.blob, language)
-                    if key not in wanted:
-                        wanted[key] = Selected(SourceFile(file.path, file.blob), language)
-        todo = [s for s in wanted.values() if not self._known(s)]
-        if not todo:
-            return
-        self.parsed += len(todo)
-        options = self.options
-        parse_all(
-            Blobs(self.repo), todo, options.languages, options.jobs, self.progress,
-            self.cache, options.limits,
-        )  # fmt: skip
+                language = self.language(file.path)
+                if language is not None and file.blob and (file.blob, language) not in found:
+                    found[(file.blob, language)] = Selected(file, language)
+        return [s for s in found.values() if not self._known(s)]
 
     def _known(self, selected: Selected) -> bool:
         cache = self.cache
         if cache is None:
             return False
-        blob = selected.file.blob
-        return cache.has(blob, selected.language) or cache.unread(blob, selected.language)
-
-    def _language(self, path: str) -> str | None:
-        return self.table.language_of(path) or self.configuration(path)
+        blob, language = selected.file.blob, selected.language
+        return cache.has(blob, language) or cache.unread(blob, language)
 
 
-def _compact(value: object) -> bytes:
-    return json.dumps(value, separators=(",", ":")).encode()
+def walk_here(
+    repo: gitpython.Repo,
+    commits: Sequence[Commit],
+    keys: dict[str, str],
+    options: DiffOptions,
+    cache: FactsCache | None,
+    progress: Progress,
+) -> tuple[dict[str, CommitStep], int]:
+    """``commits`` measured in this process (its parser workers parse what they add), in
+    windows of :data:`WINDOW`; the steps, and how many file versions were parsed."""
+    versions = FileVersions(options, cache)
+    keep = cache.put_totals if cache is not None else None
+    walk = Walk(RepositoryTrees(repo, cache), options, cache, keep, progress)
+    deltas = commit_deltas(repo, commits)
+    found: dict[str, CommitStep] = {}
+    parsed = 0
+    try:
+        for start in range(0, len(commits), WINDOW):
+            window = commits[start : start + WINDOW]
+            changes = [next(deltas) for _ in window]
+            todo = versions.wanted(changes)
+            if todo:
+                parsed += len(todo)
+                parse_all(Blobs(repo), todo, options.languages, options.jobs, progress, cache,
+                          options.limits)  # fmt: skip
+            progress.start("measuring commits", len(commits))
+            progress.advance(start)
+            found.update(walk.steps(zip(window, changes, strict=True), keys))
+    finally:
+        progress.stop()
+    return found, parsed
