@@ -15,19 +15,18 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from archmetrics.app.collect import Selected, parse_all
-from archmetrics.app.coupling import configuration_files, packs_digest
+from archmetrics.app.collect import limits_salt, parse_all
+from archmetrics.app.coupling import packs_digest
 from archmetrics.app.diff import DiffOptions, DiffRequest, diff_options
-from archmetrics.app.history_walk import Walk
+from archmetrics.app.history_walk import FileVersions, Walk, kept_step
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.tree import STATE_RECORD, Side, side_of, whole_side
 from archmetrics.changeset.gates import check_gates
-from archmetrics.changeset.history import STEP_RECORD, CommitStep, step_from_record
-from archmetrics.parsers import LanguageTable
+from archmetrics.changeset.history import STEP_RECORD, CommitStep
 from archmetrics.reports.model import HistoryEntry, HistoryReport
 from archmetrics.sources.cache import FactsCache, code_fingerprint
 from archmetrics.sources.checkout import Checkout, open_checkout
@@ -50,6 +49,8 @@ class HistoryRequest:
 
     diff: DiffRequest
     range: Range = DEFAULT_RANGE
+    scheduler: str | None = None  # a Dask scheduler's address: the walk runs on its cluster
+    workers: int | None = None  # else this many local Dask workers (None: no Dask)
 
 
 def step_key(options: DiffOptions, cache: FactsCache, commit: Commit) -> str:
@@ -63,11 +64,6 @@ def step_key(options: DiffOptions, cache: FactsCache, commit: Commit) -> str:
     return f"{STEP_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
 
 
-def _kept(data: bytes) -> CommitStep | None:
-    try:
-        return step_from_record(json.loads(data))
-    except ValueError:
-        return None
 
 
 def run_history(
@@ -90,14 +86,18 @@ def run_history(
     if cache is not None:
         kept = cache.get_totals(keys)
         for commit, key in zip(commits, keys, strict=True):
-            step = _kept(kept[key]) if key in kept else None
+            step = kept_step(kept[key]) if key in kept else None
             if step is not None:
                 steps[commit.id] = step
     missing = [c for c in commits if c.id not in steps]
     parsed = 0
     if missing:
         by_id = dict(zip((c.id for c in commits), keys, strict=False))
-        measured, parsed = walk_here(checkout.repo, missing, by_id, options, cache, progress)
+        if request.scheduler is not None or request.workers is not None:
+            measured, parsed = _walk_on_cluster(request, checkout, missing, by_id, options,
+                                                cache, progress)  # fmt: skip
+        else:
+            measured, parsed = walk_here(checkout.repo, missing, by_id, options, cache, progress)
         steps.update(measured)
     entries = tuple(
         HistoryEntry(c.id, c.parent, c.time, c.subject, c.merge, steps[c.id],
@@ -128,35 +128,25 @@ class RepositoryTrees:
         return side_of(parent, options, self.cache, NoProgress())
 
 
-class FileVersions:
-    """The file versions a range of commits adds that have a language: each parsed once,
-    before the commits that hold them are walked (or found in the facts cache)."""
+def _walk_on_cluster(
+    request: HistoryRequest,
+    checkout: Checkout,
+    commits: Sequence[Commit],
+    keys: dict[str, str],
+    options: DiffOptions,
+    cache: FactsCache | None,
+    progress: Progress,
+) -> tuple[dict[str, CommitStep], int]:
+    from archmetrics.app.history_dask import ClusterWalk, cluster
 
-    def __init__(self, options: DiffOptions, cache: FactsCache | None) -> None:
-        self.options = options
-        self.cache = cache
-        self.table = LanguageTable.default(dict(options.languages))
-        self.configuration = configuration_files(options.packs)
-
-    def language(self, path: str) -> str | None:
-        return self.table.language_of(path) or self.configuration(path)
-
-    def wanted(self, changes: Iterable[Delta]) -> list[Selected]:
-        """The distinct (blob, language) of ``changes`` that the cache has no facts for."""
-        found: dict[tuple[str, str], Selected] = {}
-        for delta in changes:
-            for file in delta.changed:
-                language = self.language(file.path)
-                if language is not None and file.blob and (file.blob, language) not in found:
-                    found[(file.blob, language)] = Selected(file, language)
-        return [s for s in found.values() if not self._known(s)]
-
-    def _known(self, selected: Selected) -> bool:
-        cache = self.cache
-        if cache is None:
-            return False
-        blob, language = selected.file.blob, selected.language
-        return cache.has(blob, language) or cache.unread(blob, language)
+    assert checkout.repo is not None
+    if cache is None:
+        raise SourceError("a history on a Dask cluster keeps its facts in a cache: leave it on")
+    progress.phase("connecting to the Dask cluster")
+    with cluster(request.scheduler, request.workers) as client:
+        salt = limits_salt(request.diff.settings)
+        walk = ClusterWalk(client, checkout.repo, options, cache, salt, progress)
+        return walk.run(commits, keys)
 
 
 def walk_here(
@@ -170,18 +160,17 @@ def walk_here(
     """``commits`` measured in this process (its parser workers parse what they add), in
     windows of :data:`WINDOW`; the steps, and how many file versions were parsed."""
     versions = FileVersions(options, cache)
+    misses = cache.misses if cache is not None else 0
     keep = cache.put_totals if cache is not None else None
     walk = Walk(RepositoryTrees(repo, cache), options, cache, keep, progress)
     deltas = commit_deltas(repo, commits)
     found: dict[str, CommitStep] = {}
-    parsed = 0
     try:
         for start in range(0, len(commits), WINDOW):
             window = commits[start : start + WINDOW]
             changes = [next(deltas) for _ in window]
             todo = versions.wanted(changes)
             if todo:
-                parsed += len(todo)
                 parse_all(Blobs(repo), todo, options.languages, options.jobs, progress, cache,
                           options.limits)  # fmt: skip
             progress.start("measuring commits", len(commits))
@@ -189,4 +178,6 @@ def walk_here(
             found.update(walk.steps(zip(window, changes, strict=True), keys))
     finally:
         progress.stop()
-    return found, parsed
+    # every version parsed: those the commits add, and a first tree read whole (each was a
+    # look-up the cache missed)
+    return found, (cache.misses - misses if cache is not None else 0)

@@ -13,10 +13,13 @@ import json
 from collections.abc import Callable, Iterable, Sequence
 from typing import Protocol
 
+from archmetrics.app.collect import Selected
+from archmetrics.app.coupling import configuration_files
 from archmetrics.app.diff import DiffOptions, compare_sides
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.tree import Side, patched_side, whole_side
-from archmetrics.changeset.history import CommitStep, commit_step, step_record
+from archmetrics.changeset.history import CommitStep, commit_step, step_from_record, step_record
+from archmetrics.parsers import LanguageTable
 from archmetrics.sources import Snapshot
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.gitdelta import Delta, Pending
@@ -39,6 +42,46 @@ class Trees(Protocol):
 
 def record_bytes(step: CommitStep) -> bytes:
     return json.dumps(step_record(step), separators=(",", ":")).encode()
+
+
+def kept_step(data: bytes) -> CommitStep | None:
+    """The step a record holds, or None for anything :func:`record_bytes` did not write
+    (the facts cache, where records are kept, is not trusted)."""
+    try:
+        return step_from_record(json.loads(data))
+    except ValueError:
+        return None
+
+
+class FileVersions:
+    """The file versions a range of commits adds that have a language: each parsed once,
+    before the commits that hold them are walked (or found in the facts cache)."""
+
+    def __init__(self, options: DiffOptions, cache: FactsCache | None) -> None:
+        self.options = options
+        self.cache = cache
+        self.table = LanguageTable.default(dict(options.languages))
+        self.configuration = configuration_files(options.packs)
+
+    def language(self, path: str) -> str | None:
+        return self.table.language_of(path) or self.configuration(path)
+
+    def wanted(self, changes: Iterable[Delta]) -> list[Selected]:
+        """The distinct (blob, language) of ``changes`` that the cache has no facts for."""
+        found: dict[tuple[str, str], Selected] = {}
+        for delta in changes:
+            for file in delta.changed:
+                language = self.language(file.path)
+                if language is not None and file.blob and (file.blob, language) not in found:
+                    found[(file.blob, language)] = Selected(file, language)
+        return [s for s in found.values() if not self._known(s)]
+
+    def _known(self, selected: Selected) -> bool:
+        cache = self.cache
+        if cache is None:
+            return False
+        blob, language = selected.file.blob, selected.language
+        return cache.has(blob, language) or cache.unread(blob, language)
 
 
 class Walk:

@@ -14,6 +14,7 @@ import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
+from archmetrics.app.history_dask import ClusterError
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
@@ -57,6 +58,7 @@ CANNOT_MEASURE = (
     ManifestError,
     CacheError,
     PlanError,
+    ClusterError,
 )
 
 

@@ -48,7 +48,11 @@ def history_command(args: argparse.Namespace) -> int:
         raise UsageError("--top needs a number of at least 0")
     fmt = HistoryFormat(args.format)
     checkout = open_checkout(args.repo)
-    request = HistoryRequest(diff_request(args, checkout), history_range(args))
+    if args.workers is not None and args.workers < 1:
+        raise UsageError("--workers needs a number of at least 1")
+    request = HistoryRequest(
+        diff_request(args, checkout), history_range(args), args.scheduler, args.workers
+    )
     shown = OutputFormat.TABLE if fmt is HistoryFormat.TABLE else OutputFormat.JSON
     with _history_cache(args, request.diff.settings) as cache, shown_progress(
         shown, args.quiet

@@ -137,6 +137,14 @@ def add_history(commands: argparse._SubParsersAction[Parser]) -> None:
         help="how many costliest commits and hotspot elements to show (default 10)",
     )  # fmt: skip
     history.add_argument("--element", metavar="NAME", help="also show this element's own trend")
+    history.add_argument(
+        "--scheduler", metavar="ADDRESS",
+        help="run on the Dask cluster whose scheduler is at ADDRESS, e.g. tcp://host:8786"
+        " (needs archmetrics[dask]; docs/performance.md, \"History on a cluster\")",
+    )  # fmt: skip
+    history.add_argument(
+        "--workers", type=int, metavar="N", help="run on a local Dask cluster of N workers"
+    )
     add_locations(history)
     add_chart(history)
     add_output(history, ["table", "json", "markdown", "csv"])

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from functools import cache
 from importlib import metadata
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import archmetrics
 from archmetrics.facts import FileFacts
@@ -193,6 +193,27 @@ class FactsCache:
         if not self._bodies:
             return False
         return self._run(lambda db: db.execute(_HAS, key).fetchone()) is not None
+
+    def get_encoded(self, keys: Sequence[tuple[str, str]]) -> dict[tuple[str, str], bytes]:
+        """The records kept for these (blob, language) pairs, as ``put_encoded`` takes them
+        (a history sends them to a worker that has no cache of its own); a record without
+        its body is left out."""
+        found: dict[tuple[str, str], bytes] = {}
+        if not self._bodies:
+            return found
+        for blob, language in keys:
+            key = (blob, language, self.fingerprint)
+
+            def row(db: sqlite3.Connection, query: str, key: tuple[str, ...] = key) -> Any:
+                return db.execute(query, key).fetchone()
+
+            head = self._run(lambda db: row(db, _HEAD))
+            body = self._run(lambda db: row(db, _BODY))
+            if head is None or body is None:
+                continue
+            if isinstance(head[0], bytes) and head[1] and isinstance(body[0], bytes):
+                found[(blob, language)] = bytes(head[0]) + b"\n" + bytes(body[0])
+        return found
 
     def _forget(self, key: tuple[str, str, str]) -> None:
         self._run(lambda db: db.execute(f"delete from facts where {_KEY}", key))
