@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
 DEFAULT_RANGE = Range()
 WINDOW = 400  # commits whose new file versions are parsed together, before they are walked
+DECODED_IN_HISTORY = 3000  # decoded facts a history keeps in memory (a diff keeps 50,000)
 
 
 @dataclass(frozen=True, slots=True)
@@ -161,6 +162,8 @@ def walk_here(
     windows of :data:`WINDOW`; the steps, and how many file versions were parsed."""
     versions = FileVersions(options, cache)
     misses = cache.misses if cache is not None else 0
+    if cache is not None:  # a commit reads its changed files and what reaches them, no more
+        cache.decoded_limit = min(cache.decoded_limit, DECODED_IN_HISTORY)
     keep = cache.put_totals if cache is not None else None
     walk = Walk(RepositoryTrees(repo, cache), options, cache, keep, progress)
     deltas = commit_deltas(repo, commits)

@@ -229,7 +229,7 @@ class ClusterWalk:
         task = RangeTask(self.options, self.salt, self.cache.fingerprint, listing,
                          tuple(commits), tuple(deltas), ())  # fmt: skip
         needed = self._needed(task)
-        unread = tuple(k for k in needed if self.cache.unread(*k))
+        unread = tuple(k for k in needed if self.cache.marked_unread(*k))
         self._scatter([k for k in needed if k not in unread and k not in self.scattered])
         return RangeTask(task.options, task.salt, task.fingerprint, task.base, task.commits,
                          task.deltas, unread)  # fmt: skip

@@ -81,7 +81,7 @@ class FileVersions:
         if cache is None:
             return False
         blob, language = selected.file.blob, selected.language
-        return cache.has(blob, language) or cache.unread(blob, language)
+        return cache.has(blob, language) or cache.marked_unread(blob, language)
 
 
 class Walk:

@@ -75,9 +75,15 @@ def _compiled(pattern: str) -> GitIgnoreSpec:
     return compile_glob(normalize_callee(pattern))
 
 
+@lru_cache(maxsize=65536)
 def matches(pattern: str, callee: str) -> bool:
-    """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches."""
-    return _compiled(pattern).match_file(normalize_callee(callee))
+    """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches:
+    a pattern without a wild card is the normalized name itself; the answer is kept (a
+    function's calls are tried against each hint of each of its sites)."""
+    name, _ = _normalized(callee)
+    if not any(c in pattern for c in "*?[\\") and not pattern.startswith(("!", "#")):
+        return name == normalize_callee(pattern)
+    return _compiled(pattern).match_file(name)
 
 
 def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
