@@ -54,15 +54,20 @@ class HistoryRequest:
     workers: int | None = None  # else this many local Dask workers (None: no Dask)
 
 
-def step_key(options: DiffOptions, cache: FactsCache, commit: Commit) -> str:
-    """A digest of all that decides one commit's step: archmetrics's code, the facts' parser
-    fingerprint, the options a tree's state depends on, and the two trees compared."""
+def step_keys(
+    options: DiffOptions, cache: FactsCache, commits: Sequence[Commit]
+) -> list[str]:
+    """Per commit, a digest of all that decides its step: archmetrics's code, the facts'
+    parser fingerprint, the options a tree's state depends on (made once), and the two
+    trees compared."""
     document = [
         STEP_RECORD, STATE_RECORD, code_fingerprint(), cache.fingerprint, options.languages,
         repr(options.rules), options.limits.skip_generated, repr(options.coupling),
-        packs_digest(options.packs), options.dynamic_pre_zero, commit.parent_tree, commit.tree,
+        packs_digest(options.packs), options.dynamic_pre_zero,
     ]  # fmt: skip
-    return f"{STEP_RECORD}:{hashlib.sha256(json.dumps(document).encode()).hexdigest()}"
+    settings = hashlib.sha256(json.dumps(document).encode()).hexdigest()
+    pairs = (f"{settings} {c.parent_tree} {c.tree}".encode() for c in commits)
+    return [f"{STEP_RECORD}:{hashlib.sha256(pair).hexdigest()}" for pair in pairs]
 
 
 
@@ -82,7 +87,7 @@ def run_history(
         raise SourceError(f"{checkout.root}: history needs a git repository")
     progress.phase(f"listing the commits of {request.range.spec}")
     commits = list_commits(checkout.repo, request.range)
-    keys = [step_key(options, cache, c) for c in commits] if cache is not None else []
+    keys = step_keys(options, cache, commits) if cache is not None else []
     steps: dict[str, CommitStep] = {}
     if cache is not None:
         kept = cache.get_totals(keys)
@@ -179,6 +184,7 @@ def walk_here(
             progress.start("measuring commits", len(commits))
             progress.advance(start)
             found.update(walk.steps(zip(window, changes, strict=True), keys))
+        walk.keep_state()
     finally:
         progress.stop()
     # every version parsed: those the commits add, and a first tree read whole (each was a

@@ -17,7 +17,7 @@ from archmetrics.app.collect import Selected
 from archmetrics.app.coupling import configuration_files
 from archmetrics.app.diff import DiffOptions, compare_sides
 from archmetrics.app.progress import NoProgress, Progress
-from archmetrics.app.tree import Side, patched_side, whole_side
+from archmetrics.app.tree import Side, patched_side, state_key, whole_side
 from archmetrics.changeset.history import CommitStep, commit_step, step_from_record, step_record
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources import Snapshot
@@ -119,6 +119,17 @@ class Walk:
         finally:
             self.flush()
         return found
+
+    def keep_state(self) -> None:
+        """The last commit's tree state kept in the cache (as a diff keeps the states it
+        builds): the next history of this branch, one commit longer, starts from it."""
+        side, cache = self.pre, self.cache
+        tree = getattr(side.snapshot, "tree", None) if side is not None else None
+        if side is None or cache is None or not tree:
+            return
+        from archmetrics.sources.statecodec import encode
+
+        cache.put_total(state_key(tree, self.options, cache), encode(side.state))
 
     def flush(self) -> None:
         if self.keep is not None and self.pending:
