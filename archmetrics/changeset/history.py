@@ -150,6 +150,14 @@ def _element(data: Mapping[str, object]) -> ElementChange:
     )
 
 
+def _cost(scaled_changes: float, delta_vg: float, scaled_delta_vg: float) -> float:
+    """E_e = ΣΓ'_e / ΣΔVg'_e, and 0 when the element's complexity is where it started
+    (ΣΔVg_e = 0: eq. 6.38's case; the scaled sum is then only the scales' rounding)."""
+    if delta_vg == 0 or scaled_delta_vg == 0:
+        return 0.0
+    return scaled_changes / scaled_delta_vg
+
+
 @dataclass(frozen=True, slots=True)
 class ElementTotals:
     """One element over a range: the commits that changed it (Γ_e > 0), ΣΓ'_e, ΣΔVg'_e and
@@ -163,15 +171,16 @@ class ElementTotals:
     cost: float
 
 
-def element_share(step: CommitStep, element: ElementChange) -> tuple[int, float, float]:
-    """Γ_e, Γ'_e and ΔVg'_e of ``element`` in ``step``: its changes and complexity change,
-    scaled by its location's λ̂ and v̂g (an undefined scale is taken as 1, as for S(L))."""
+def element_share(step: CommitStep, element: ElementChange) -> tuple[int, float, int, float]:
+    """Γ_e, Γ'_e, ΔVg_e and ΔVg'_e of ``element`` in ``step``: its changes and complexity
+    change, the scaled ones by its location's λ̂ and v̂g (an undefined scale is taken as 1,
+    as for S(L))."""
     summary = step.summaries[element.location.value]
     changes = element.added + element.removed + element.modified
     delta_vg = (element.post.vg if element.post else 0) - (element.pre.vg if element.pre else 0)
     loc_scale = 1.0 if summary.loc_scale is None else summary.loc_scale
     vg_scale = 1.0 if summary.vg_scale is None else summary.vg_scale
-    return changes, loc_scale * changes, vg_scale * delta_vg + 0.0
+    return changes, loc_scale * changes, delta_vg, vg_scale * delta_vg + 0.0
 
 
 def element_totals(steps: Iterable[CommitStep]) -> tuple[ElementTotals, ...]:
@@ -181,18 +190,18 @@ def element_totals(steps: Iterable[CommitStep]) -> tuple[ElementTotals, ...]:
     where: dict[str, str] = {}
     for step in steps:
         for element in step.elements:
-            changes, scaled, scaled_vg = element_share(step, element)
+            changes, scaled, delta_vg, scaled_vg = element_share(step, element)
             if not changes:
                 continue
-            totals = found.setdefault(element.element, [0, 0.0, 0.0])
+            totals = found.setdefault(element.element, [0, 0.0, 0, 0.0])
             totals[0] += 1
             totals[1] += scaled
-            totals[2] += scaled_vg
+            totals[2] += delta_vg
+            totals[3] += scaled_vg
             where[element.element] = element.location.value
     rows = [
-        ElementTotals(name, where[name], int(t[0]), t[1], t[2] + 0.0,
-                      t[1] / t[2] if t[2] else 0.0)
+        ElementTotals(name, where[name], int(t[0]), t[1], t[3] + 0.0, _cost(t[1], t[2], t[3]))
         for name, t in found.items()
-    ]  # fmt: skip
+    ]
     rows.sort(key=lambda r: (-r.scaled_changes, r.element))
     return tuple(rows)

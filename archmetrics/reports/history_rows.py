@@ -88,7 +88,7 @@ def trend_rows(report: HistoryReport, element: str) -> list[list[str]]:
         for change in entry.step.elements:
             if change.element != element:
                 continue
-            changes, _, _ = element_share(entry.step, change)
+            changes, _, _, _ = element_share(entry.step, change)
             after = change.post
             metrics = [number(v) for v in after] if after else ["-"] * 7
             loc, _sloc, vg, *coupling = metrics
