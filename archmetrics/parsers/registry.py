@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
@@ -90,11 +91,15 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
 )
 
 
-@functools.cache
 def _plugin_languages() -> tuple[LanguageSpec, ...]:
-    """The languages plugins announce, read once per process: scanning the installed
+    """The languages plugins announce, read once per import path: scanning the installed
     distributions' entry points costs tens of milliseconds, and a history builds its
-    language table for every commit."""
+    language table for every commit (a path added later, as a test does, is read then)."""
+    return _plugins_on(tuple(sys.path))
+
+
+@functools.lru_cache(maxsize=8)
+def _plugins_on(path: tuple[str, ...]) -> tuple[LanguageSpec, ...]:
     found = []
     for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
         spec = entry.load()
