@@ -348,13 +348,13 @@ def measure_snapshots(
     else:
         moved = renames() if callable(renames) else renames
     progress.phase("comparing the changed files")
-    change = _compare(pre, post, moved, options, progress, cache)
+    change = compare_sides(pre, post, moved, options, progress, cache)
     progress.stop()
     change = for_gates(change, pre, post, options.rules, bool(options.unit_gates))
     return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
 
 
-def _compare(
+def compare_sides(
     pre: Side,
     post: Side,
     renames: Mapping[str, str],

@@ -14,10 +14,11 @@ import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
+from archmetrics.app.history_dask import ClusterError
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
-from archmetrics.cli import baseline, docs, estimate, measure, study
+from archmetrics.cli import baseline, docs, estimate, history, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
@@ -37,6 +38,7 @@ COMMANDS = {
     "diff": measure.diff_command,
     "series": measure.series_command,
     "compare": measure.compare_command,
+    "history": history.history_command,
     "estimate": estimate.estimate_command,
     "replicate": study.replicate_command,
     "rules": measure.rules_command,
@@ -58,6 +60,7 @@ CANNOT_MEASURE = (
     CacheError,
     PlanError,
     baseline.BaselineError,
+    ClusterError,
 )
 
 

@@ -128,6 +128,47 @@ def add_locations(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_history(commands: argparse._SubParsersAction[Parser]) -> None:
+    history = commands.add_parser(
+        "history",
+        help="every commit of a branch against its first parent: Γ, ΔVg', E per location,"
+        " the costliest commits and the elements where integration cost accumulates",
+    )
+    history.add_argument(
+        "range", nargs="?", default="HEAD", metavar="REV_RANGE",
+        help="the commits, as git log takes them (default HEAD: its whole history)",
+    )  # fmt: skip
+    history.add_argument(
+        "--first-parent", action=argparse.BooleanOptionalAction, default=True,
+        help="follow only first parents, each merge one integrated branch (default: on)",
+    )  # fmt: skip
+    history.add_argument(
+        "--merges", action="store_true", help="only merge commits, each against its first parent"
+    )
+    history.add_argument("--since", metavar="DATE", help="commits after DATE (as git reads it)")
+    history.add_argument("--until", metavar="DATE", help="commits before DATE")
+    history.add_argument(
+        "--max-count", "-n", type=int, metavar="N", help="only the newest N commits"
+    )
+    history.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    history.add_argument(
+        "--top", type=int, default=10, metavar="N",
+        help="how many costliest commits and hotspot elements to show (default 10)",
+    )  # fmt: skip
+    history.add_argument("--element", metavar="NAME", help="also show this element's own trend")
+    history.add_argument(
+        "--scheduler", metavar="ADDRESS",
+        help="run on the Dask cluster whose scheduler is at ADDRESS, e.g. tcp://host:8786"
+        " (needs archmetrics[dask]; docs/history.md)",
+    )  # fmt: skip
+    history.add_argument(
+        "--workers", type=int, metavar="N", help="run on a local Dask cluster of N workers"
+    )
+    add_locations(history)
+    add_chart(history)
+    add_output(history, ["table", "json", "markdown", "csv"])
+
+
 def docs_epilog() -> str:
     """Where the installed pages are, for --help (they ship inside the wheel)."""
     root = docs_root()
@@ -251,6 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    add_history(commands)
     estimate = commands.add_parser(
         "estimate",
         help="price an integration before doing it: each architecture of a plan (TOML) or"

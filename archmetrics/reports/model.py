@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from archmetrics.changeset.accuracy import ChangeAccuracy
 from archmetrics.changeset.gates import GateFailure, GateOrigin
+from archmetrics.changeset.history import CommitStep
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
@@ -216,3 +217,38 @@ class EstimateReport:
                 for i, (name, t) in enumerate(totals, start=1)
             ]
         return tuple(ranked)
+
+
+HISTORY_SCHEMA = "archmetrics.history/1"
+
+
+@dataclass(frozen=True, slots=True)
+class HistoryEntry:
+    """One commit of a history against its first parent (``parent`` None: a root commit,
+    against the empty tree), with the gates that fail on it."""
+
+    commit: str
+    parent: str | None
+    time: int  # committer date, seconds since the epoch (UTC)
+    subject: str
+    merge: bool
+    step: CommitStep
+    failures: tuple[GateFailure, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class HistoryReport:
+    """Every commit of a range, oldest first. ``measured``: how many commits this run
+    measured (the others' steps were kept from an earlier run); ``parsed``: how many file
+    versions it parsed."""
+
+    repo: str
+    range: str
+    entries: tuple[HistoryEntry, ...]
+    gates: tuple[str, ...] = ()
+    measured: int = 0
+    parsed: int = 0
+
+    @property
+    def failures(self) -> tuple[GateFailure, ...]:
+        return tuple(f for e in self.entries for f in e.failures)

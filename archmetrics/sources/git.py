@@ -207,17 +207,21 @@ class _BlobReader:
 
 
 class RevisionSnapshot(_BlobReader):
-    """The tree of a commit."""
+    """The tree of a commit. ``commit`` and ``tree``: the ids, when the caller knows them
+    already (a history lists both for every commit), so that git is not asked again."""
 
-    def __init__(self, repo: git.Repo, rev: str):
+    def __init__(self, repo: git.Repo, rev: str, commit: str = "", tree: str = ""):
         super().__init__(repo)
-        self.commit = resolve(repo, rev)
+        self.commit = commit or resolve(repo, rev)
         self.label = rev
+        self._tree = tree
 
     @property
     def tree(self) -> str:
         """The commit's tree id: what names this snapshot's content."""
-        return _ls(self.repo, "rev-parse", f"{self.commit}^{{tree}}")[0].strip()
+        if not self._tree:
+            self._tree = _ls(self.repo, "rev-parse", f"{self.commit}^{{tree}}")[0].strip()
+        return self._tree
 
     def delta_from(self, commit: str) -> Pending:
         """What differs from ``commit`` (a commit id) to this commit (gitdelta.py)."""
@@ -231,6 +235,16 @@ class RevisionSnapshot(_BlobReader):
             if kind == "blob" and mode != "120000":  # skip symlinks and submodules
                 found.append(SourceFile(quote_path(path), blob))
         return tuple(sorted(found))
+
+
+class Blobs(_BlobReader):
+    """A repository's blobs, read by id: the file versions a history parses before it walks
+    the commits that hold them."""
+
+    label = "history"
+
+    def files(self) -> tuple[SourceFile, ...]:
+        return ()
 
 
 class IndexSnapshot(_BlobReader):
