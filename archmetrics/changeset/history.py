@@ -103,12 +103,15 @@ def _float(value: object) -> float:
     return float(value)
 
 
+_SUMMARY_KEYS = (*SUMMARY_FIELDS, "unparsed")  # what Summary.to_dict writes
+
+
 def summary_from_dict(data: Mapping[str, object]) -> Summary:
     """The :class:`Summary` whose ``to_dict`` gives ``data`` (every field checked)."""
-    if set(data) != set(SUMMARY_FIELDS):
+    if set(data) != set(_SUMMARY_KEYS):
         raise ValueError("a summary's fields differ")
     values: dict[str, object] = {}
-    for name in SUMMARY_FIELDS:
+    for name in _SUMMARY_KEYS:
         value = data[name]
         if name == "notes":
             values[name] = tuple(str(_text(n)) for n in _sequence(value))

@@ -7,9 +7,10 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from archmetrics import __version__
 from archmetrics.reports import history_rows as rows
 from archmetrics.reports.frames import Table, history_table
-from archmetrics.reports.json_report import dumps
+from archmetrics.reports.json_report import dumps, gate_values
 from archmetrics.reports.model import HISTORY_SCHEMA, LOCATION_COLUMNS, HistoryReport
 
 
@@ -52,10 +53,14 @@ def history_dict(report: HistoryReport, view: View) -> dict[str, Any]:
             "merge": entry.merge,
             "locations": {k: entry.step.summaries[k].to_dict() for k in LOCATION_COLUMNS},
             "elements": [e.to_dict() for e in entry.step.elements],
-            "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+            "gates": [
+                {"gate": g, "failed": g in failed, "values": gate_values(g, entry.step.summaries)}
+                for g in report.gates
+            ],
         })  # fmt: skip
     document: dict[str, Any] = {
         "schema": HISTORY_SCHEMA,
+        "tool": {"name": "archmetrics", "version": __version__},
         "repo": report.repo,
         "range": report.range,
         "measured": report.measured,

@@ -184,7 +184,7 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
         "gates": [
             {**unit_gate(g, report), "values": {}}
             if is_unit_gate(g)
-            else {"gate": g, "failed": g in failed, "values": _gate_values(g, summaries)}
+            else {"gate": g, "failed": g in failed, "values": gate_values(g, summaries)}
             for g in report.gates
         ],
         "base_commit": report.commits[0],
@@ -193,7 +193,7 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
     }
 
 
-def _gate_values(text: str, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
+def gate_values(text: str, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
     """What each condition of the gate ``text`` measured (``FIELD(LOCATION)``: value)."""
     return measured_values(parse_gate(text), summaries)
 

@@ -18,7 +18,7 @@ from archmetrics.changeset.model import ElementChange, Metrics, Status, Summary
 
 def _summary(loc_scale: float | None, vg_scale: float | None) -> Summary:
     return Summary(0, 0, 0, 0, 100, 110, loc_scale, 1, 0, 0, 1, 1.0, 50, 52, vg_scale, 2, 2.0,
-                   0.5, ("a note",))  # fmt: skip
+                   0.5, ("a note",), unparsed=2)  # fmt: skip
 
 
 def _element(name: str, vg_pre: int, vg_post: int, added: int, removed: int = 0) -> ElementChange:
@@ -61,6 +61,7 @@ def test_an_element_back_where_it_started_costs_zero_not_the_scales_rounding() -
 def test_a_record_round_trips_and_a_strange_one_is_refused() -> None:
     step = _step(1.1, None, _element("a", 5, 8, added=4))
     record = json.loads(json.dumps(step_record(step)))
+    assert set(record["locations"]["total"]) == set(step.summaries["total"].to_dict())
     assert step_from_record(record) == step
     assert json.dumps(step_record(step_from_record(record))) == json.dumps(step_record(step))
     broken = json.loads(json.dumps(record))
