@@ -21,6 +21,7 @@ class FunctionMetrics:
     end_line: int
     loc: int
     vg: int
+    suppressed: tuple[str, ...] = ()  # fields a reviewer's comment exempts it from
     estimated: bool = False  # read from tokens in part or whole: v_g estimated
 
 
@@ -99,6 +100,7 @@ def file_metrics(facts: FileFacts) -> FileMetrics:
             end_line=f.span.end,
             loc=f.statements,
             vg=f.complexity,
+            suppressed=f.suppressed,
             estimated=f.estimated,
         )
         for f in facts.functions

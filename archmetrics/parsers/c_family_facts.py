@@ -118,7 +118,7 @@ def facts(
                 tuple(s.decisions),
                 s.statements,
                 s.parameters,
-                s.estimated,
+                estimated=s.estimated,
             )
             for s in slots
         ),
