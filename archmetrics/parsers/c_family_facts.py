@@ -28,7 +28,7 @@ from archmetrics.parsers.c_family_names import Scopes, in_order, typedef_names
 from archmetrics.parsers.c_family_outline import classes, includes
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
 from archmetrics.parsers.c_family_text import blank_comments, sloc, whole_lines
-from archmetrics.parsers.c_family_trust import Area, Lines, amend, areas_of, reconcile
+from archmetrics.parsers.c_family_trust import Area, Lines, amend, areas_of, macro_heads, reconcile
 from archmetrics.parsers.c_family_warnings import Counted, warnings
 
 
@@ -239,6 +239,9 @@ def suspect_regions(
         head = next((s for s in slots if s.body_start == node.start_byte), None)
         if head is not None:
             regions.append((*whole_lines(data, head.start, node.start_byte), "head"))
+    regions += [
+        (*whole_lines(data, start, end), cause) for start, end, cause in macro_heads(slots, data)
+    ]
     return regions
 
 

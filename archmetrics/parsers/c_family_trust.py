@@ -34,6 +34,7 @@ _DEFINE = re.compile(
 
 
 _PARENTHESES = re.compile(rb"\([^()]*+\)")
+_ALIAS = re.compile(rb"[A-Za-z_][\w:]*+")
 
 
 class Lines:
@@ -88,6 +89,8 @@ def _macro_names(data: bytes) -> frozenset[str]:
     names = set()
     for found in _DEFINE.finditer(data):
         body = found.group(3).replace(b"\\\n", b" ").rstrip(b" \t\\")
+        if found.group(2) is None and _ALIAS.fullmatch(body.strip()):
+            continue  # `#define Buffer mock::Buffer`: another name for a real one
         last = body[max(body.rfind(b";"), body.rfind(b"}")) + 1 :]
         outside = _PARENTHESES.sub(b"", last)
         while outside != (inner := _PARENTHESES.sub(b"", outside)):
@@ -96,6 +99,15 @@ def _macro_names(data: bytes) -> frozenset[str]:
         if not head_like:
             names.add(found.group(1).decode("utf-8", "replace"))
     return frozenset(names)
+
+
+def macro_heads(slots: list[FunctionSlot], data: bytes) -> list[tuple[int, int, str]]:
+    """The heads of the functions the tree named after a macro the file defines as no
+    function head (``#define LJFOLD(x)`` empty, then ``LJFOLD(ADD)`` / ``LJFOLDF(f) {``):
+    suspect, (start, end, "head") in bytes."""
+    named = [slot for slot in slots if slot.name.isupper()]
+    macros = _macro_names(data) if named and b"define" in data else frozenset()
+    return [(s.start, s.body_start, "head") for s in named if s.name in macros]
 
 
 def _matches(

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import pytest
 
-from archmetrics.facts import FileFacts
+from archmetrics.facts import FileFacts, Language
+from archmetrics.parsers import c_family
 from tests.harness import facts_of
 
 
@@ -516,6 +517,52 @@ def test_macro_calls_before_a_function_head_do_not_name_it() -> None:
     assert messages(facts) == [
         "lines 1-5: the head of main read as 'GENERATE_TEST' (macro calls without their ';'"
         " read as a function's head)"
+    ]
+
+
+RULE_MACROS = """\
+#define RULE(x)
+#define RULEX(x)
+#define RULEF(name)\tstatic int CALLCONV rule_##name(State *s)
+/* -- rules for numbers -- */
+
+RULE(ADD NUM NUM)
+RULE(SUB NUM NUM)
+RULE(MUL NUM NUM)
+RULEF(numarith)
+{
+  number a = left;
+  number y = a > 0 ? arith(a, s->op) : 0;
+  return knum(s, y);
+}
+
+RULE(NEG NUM LOAD)
+RULEF(numneg)
+{
+  if (a) return 2;
+  return 0;
+}
+"""
+
+
+def test_a_function_named_after_an_empty_macro_takes_the_head_macros_name() -> None:
+    # LuaJIT's lj_opt_fold.c: `#define LJFOLD(x)` (empty) tags the function that
+    # `LJFOLDF(name)` declares; tree-sitter read the tags and the head as one head named
+    # after the first tag, a macro whose body is no function head
+    tree = c_family.parse("x.c", RULE_MACROS, Language.C, second_reading=False)
+    assert [(f.name, f.span.start) for f in tree.functions] == [("RULE", 6)]
+    facts = c(RULE_MACROS)
+    assert [
+        (f.name, f.span.start, f.span.end, f.complexity, f.estimated) for f in facts.functions
+    ] == [
+        ("RULEF", 9, 14, 2, False),
+        ("RULEF", 17, 21, 2, True),
+    ]
+    assert messages(facts) == [
+        "lines 6-10: the head of RULEF read as 'RULE' (macro calls without their ';' read as"
+        " a function's head)",
+        "lines 17-21: 1 function read from tokens only, v_g estimated (a block outside any"
+        " function (a K&R definition or a macro?))",
     ]
 
 
