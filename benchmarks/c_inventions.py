@@ -22,7 +22,15 @@ A function of lizard's is its invention (left out of "lizard's real functions") 
     function exists only where the macro is used);
   * it lies inside another function lizard reports (``HWY_IF_CONSTEXPR(c) {`` in a body);
   * it is a method of a class defined inside one of our functions (our rule, and lizard's
-    own when it sees the function around it: docs/metrics.md, v_g).
+    own when it sees the function around it: docs/metrics.md, v_g);
+  * it is a call inside an expression (an operator or ``return`` before its name: ``k =
+    c ? ir_khash(as, key) : 1;`` after lizard closed the function around it too early), or
+    its parentheses hold an expression (``HWY_IF_CONSTEXPR(!k) {``);
+  * it is one of our functions cut short: the same name, starting in its head, ending
+    before it (a brace initializer in ``noexcept(...)`` read as the body).
+
+Those last two are also no evidence against ours: a function of ours that covers one of
+them is not made up for it.
 """
 
 from __future__ import annotations
@@ -143,12 +151,19 @@ def keyword(name: str) -> bool:
     return last in KEYWORDS
 
 
+_ALIAS = re.compile(r"[A-Za-z_][\w:]*")
+
+
 def macro_names(source: str) -> frozenset[str]:
     """The macros ``source`` defines whose body does not end in a function head after its
-    last `;` or `}` (a test macro may define a class, then its method's head)."""
+    last `;` or `}` (a test macro may define a class, then its method's head); a macro
+    without parameters whose body is a (qualified) name is another name for what it names,
+    and no such macro."""
     names = set()
     for found in _DEFINE.finditer(source):
         body = found.group(3).replace("\\\n", " ").rstrip(" \t\\")
+        if found.group(2) is None and _ALIAS.fullmatch(body.strip()):
+            continue  # `#define Buffer mock::Buffer`: another name for a real one
         last = body[max(body.rfind(";"), body.rfind("}")) + 1 :]
         outside = last
         while True:  # a default argument's `=` is no initializer's
@@ -215,10 +230,60 @@ def made_up(
                 and other.end < function.end
                 and not any(s <= other.start and other.end <= e for s, e in local_classes)
                 and not keyword(other.name)
+                and not call_read_as_function(lines, other)
+                and not same_head(lines, function, other)
             ]
             if covered:
                 found.append((function, f"covers {covered[0].name} at {covered[0].start}"))
     return found
+
+
+_OPERATOR_BEFORE = re.compile(r"(?:[-=?(,+/%|^!]|(?<!:):|\breturn)\s*$")
+_EXPRESSION = re.compile(r"!(?!=)|==|->|[A-Za-z_)]\.[A-Za-z_]")
+
+
+def same_head(lines: list[str], function: Ours, other: Theirs) -> bool:
+    """Whether lizard's ``other`` is ``function`` cut short: the same name, starting in its
+    head (before the line of its first `{`) and ending before it (lizard took a brace
+    initializer in a ``noexcept(...)`` or ``decltype(...)`` for the body, or closed it at
+    a `}` of one #if branch)."""
+    short = other.name.rsplit("::", 1)[-1]
+    if function.name.rsplit("::", 1)[-1] != short or not (
+        function.start <= other.start and other.end < function.end
+    ):
+        return False
+    first = next(
+        (n for n in range(function.start, function.end + 1) if "{" in lines[n - 1]),
+        function.end,
+    )
+    return other.start <= first
+
+
+def call_read_as_function(lines: list[str], other: Theirs) -> bool:
+    """Whether lizard's function ``other`` is a call inside an expression, not a definition:
+    an operator or ``return`` stands before its name on its line (``khash = isk ?
+    ir_khash(as, irkey) : 1;`` after lizard closed the function around it too early), or
+    its parentheses hold an expression no parameter list holds (``HWY_IF_CONSTEXPR(!k) {``:
+    `!`, `==`, `->`, a member)."""
+    if not 0 < other.start <= len(lines):
+        return False
+    short = other.name.rsplit("::", 1)[-1]
+    text = lines[other.start - 1]
+    at = text.find(short + "(")
+    if at < 0:
+        at = text.find(short)
+    if at < 0:
+        return False
+    if _OPERATOR_BEFORE.search(text[:at]):
+        return True
+    rest = "\n".join(lines[other.start - 1 : other.start + 4])[at + len(short) :]
+    depth, inside = 0, []
+    for char in rest.lstrip():
+        depth += (char == "(") - (char == ")")
+        inside.append(char)
+        if depth == 0:
+            break
+    return bool(_EXPRESSION.search("".join(inside)))
 
 
 def _called(lines: list[str], function: Ours, name: str) -> bool:
@@ -235,10 +300,15 @@ def invention(
     ours: list[Ours],
     defines: set[int],
     local_classes: list[tuple[int, int]],
+    lines: list[str] | None = None,
 ) -> str | None:
     """The class of lizard's invention ``other`` is, or None for a real function."""
     if keyword(other.name):
         return "keyword"
+    if lines is not None and call_read_as_function(lines, other):
+        return "a call read as a function"
+    if lines is not None and any(same_head(lines, f, other) for f in ours):
+        return "the same function cut short"
     if other.start in defines:
         return "inside a #define"
     inner = {f.start for f in theirs if other.start < f.start and f.end <= other.end}

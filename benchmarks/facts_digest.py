@@ -10,7 +10,8 @@ decisions, call sites and arguments, bindings, warnings). With ``--against``, pr
 file whose digest differs or that one side lacks (``--subset``: only the files both
 sides hold), and exits 1 if there is one. Not part of
 the tests; the parser steps of docs/metrics.md ("Cost") were checked this way. A function
-whose ``estimated`` is false is digested as it was before that field existed.
+whose ``estimated`` is false and ``suppressed`` empty is digested as it was before those
+fields existed.
 """
 
 from __future__ import annotations
@@ -49,9 +50,11 @@ def digest(item: tuple[str, str]) -> tuple[str, str]:
     language = TABLE.language_of(Path(path).name)
     assert language is not None
     facts = parse_source(shown, Path(path).read_bytes(), language, TABLE)
-    # a function not estimated is written as before Function.estimated existed, so that a
-    # record made by an older checkout compares equal where nothing else changed
-    text = repr(facts).replace(", estimated=False)", ")")
+    # a function not estimated and not suppressed is written as before Function.suppressed
+    # and Function.estimated existed, so that a record made by an older checkout compares
+    # equal where nothing else changed
+    text = repr(facts).replace(", suppressed=(), estimated=False)", ")")
+    text = text.replace(", estimated=False)", ")")
     return shown, hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 

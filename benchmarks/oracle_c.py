@@ -174,13 +174,13 @@ def compare_file(item: tuple[str, str]) -> Tally:
     defines = c_inventions.define_lines(source)
     tally = Tally(files=1, functions=len(ours), estimated=sum(f.estimated for f in ours))
     theirs = []
+    lines = source.splitlines()
     for other in all_theirs:
-        kind = c_inventions.invention(other, all_theirs, ours, defines, local)
+        kind = c_inventions.invention(other, all_theirs, ours, defines, local, lines)
         if kind is None:
             theirs.append(other)
         else:
             tally.inventions[kind] = tally.inventions.get(kind, 0) + 1
-    lines = source.splitlines()
     for function, why in c_inventions.made_up(
         ours, theirs, c_inventions.macro_names(source), local, lines
     ):

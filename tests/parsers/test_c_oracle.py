@@ -8,11 +8,12 @@ we differ on purpose, docs/metrics.md names the class and a golden test shows it
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
-import subprocess
-import sys
 import tarfile
+import urllib.request
 from collections import Counter, defaultdict
 from collections.abc import Iterator
 from pathlib import Path
@@ -56,30 +57,28 @@ def _unavailable(reason: str) -> None:
 
 
 def _download(folder: Path, requirement: str) -> Path | None:
-    command = [
-        sys.executable,
-        "-m",
-        "pip",
-        "download",
-        "--no-binary",
-        ":all:",
-        "--no-deps",
-        "--quiet",
-        "--dest",
-        str(folder),
-        requirement,
-    ]
+    """The sdist of ``requirement`` (name==version), fetched from PyPI's simple index and
+    checked against its sha256 (``pip download`` would build a package's metadata, and for
+    a Cython package compile Cython first, to fetch a file)."""
+    name, version = requirement.split("==")
+    request = urllib.request.Request(
+        f"https://pypi.org/simple/{name}/",
+        headers={"Accept": "application/vnd.pypi.simple.v1+json"},
+    )
+    wanted = {f"{stem}-{version}.tar.gz" for stem in (name.lower(), name.lower().replace("-", "_"))}
     try:
-        subprocess.run(command, check=True, capture_output=True, timeout=240)
-    except (subprocess.SubprocessError, OSError):
+        with urllib.request.urlopen(request, timeout=120) as answer:
+            files = json.load(answer)["files"]
+        [entry] = [f for f in files if f["filename"].lower() in wanted]
+        with urllib.request.urlopen(entry["url"], timeout=240) as answer:
+            content = answer.read()
+    except (OSError, ValueError, KeyError):
         return None
-    name = requirement.split("==")[0].lower().replace("-", "_")
-    found = [
-        p
-        for p in folder.glob("*.tar.gz")
-        if p.name.lower().replace("-", "_").startswith(name + "_")
-    ]
-    return found[0] if found else None
+    if hashlib.sha256(content).hexdigest() != entry["hashes"].get("sha256"):
+        return None
+    archive = folder / entry["filename"]
+    archive.write_bytes(content)
+    return archive
 
 
 def _unpacked(folder: Path, archive_name: str, requirement: str) -> Path:
