@@ -68,8 +68,11 @@ def _cause(area: Area, reading: TokenReading, data: bytes) -> str:
     return f"a macro it cannot know? '{first.decode('utf-8', 'replace')}'"
 
 
-def _losses(area: Area, reading: TokenReading, counted: Counted, lines: Lines) -> list[str]:
-    """What ``area`` lost or estimated, in a reader's words (nothing: no warning)."""
+def _losses(
+    area: Area, reading: TokenReading, counted: Counted, lines: Lines, seen: Counted
+) -> list[str]:
+    """What ``area`` lost or estimated, in a reader's words (nothing: no warning);
+    ``seen``: the lines of the statements and calls the token reading found."""
     first, last = lines.of(area.start), lines.of(max(area.start, area.end - 1))
     parts: list[str] = []
     if area.added:
@@ -91,12 +94,10 @@ def _losses(area: Area, reading: TokenReading, counted: Counted, lines: Lines) -
         shown = ", ".join(repr(name) for name in dropped[:3])
         parts.append(f"{shown} read as {'a function' if len(dropped) == 1 else 'functions'}"
                      " by mistake, not reported")  # fmt: skip
-    statements = _between(_lines(reading.statements, lines), first, last) - _between(
+    statements = _between(seen.statements, first, last) - _between(
         counted.statements, first, last
     )
-    calls = _between(_lines(reading.calls, lines), first, last) - _between(
-        counted.calls, first, last
-    )
+    calls = _between(seen.calls, first, last) - _between(counted.calls, first, last)
     lost = [
         _plural(n, what) for n, what in ((statements, "statement"), (calls, "call site")) if n > 0
     ]
@@ -120,8 +121,9 @@ def warnings(
     """One warning per area that lost or estimated facts; at most ``_MAX_WARNINGS``, then
     one that says how many more."""
     problems: list[tuple[int, str]] = []
+    seen = Counted([], _lines(reading.statements, lines), _lines(reading.calls, lines))
     for area in areas:
-        parts = _losses(area, reading, counted, lines)
+        parts = _losses(area, reading, counted, lines, seen)
         if not parts:
             continue
         first, last = lines.of(area.start), lines.of(max(area.start, area.end - 1))
