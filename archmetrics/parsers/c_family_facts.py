@@ -235,6 +235,9 @@ def suspect_regions(
         if node.start_byte in bodies or (index >= 0 and node.end_byte <= inside[index][1]):
             continue  # a macro-made function's body, or a block in an #if inside a body
         regions.append((*whole_lines(data, node.start_byte, node.end_byte), "stray"))
+    regions += [
+        (*whole_lines(data, n.start_byte, n.end_byte), "braced") for n in found.get("braced", [])
+    ]
     for node in found.get("misread", []):  # the head before the body
         head = next((s for s in slots if s.body_start == node.start_byte), None)
         if head is not None:

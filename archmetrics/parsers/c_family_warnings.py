@@ -29,6 +29,7 @@ _CAUSES = {
     "keyword": "a macro read as a function's head",
     "head": "macro calls without their ';' read as a function's head",
     "branch": "an #if branch read apart from the others",
+    "braced": "a function's body read as a brace initializer",
 }
 
 
@@ -59,7 +60,7 @@ def _cause(area: Area, reading: TokenReading, data: bytes) -> str:
         return "a #define inside an initializer"
     if _ASM.search(data, start, end):
         return "inline assembly"
-    for cause in ("keyword", "head", "nested", "stray", "branch"):
+    for cause in ("keyword", "head", "nested", "stray", "braced", "branch"):
         if cause in area.causes:
             return _CAUSES[cause]
     if _CONDITIONAL.search(data, start, end):

@@ -153,6 +153,10 @@ STRAY_BLOCKS = (
     # in an #if branch: only those outside every function body are stray (c_family_facts)
     "[(preproc_if (compound_statement) @stray) (preproc_ifdef (compound_statement) @stray)"
     " (preproc_else (compound_statement) @stray) (preproc_elif (compound_statement) @stray)]",
+    # `static void f(struct s *p, t *w) {};`: tree-sitter-cpp reads a declaration with a
+    # brace initializer, which no function declarator can have: the body of a definition
+    "(declaration declarator: (init_declarator declarator: (function_declarator)"
+    " value: (initializer_list) @braced))",
 )
 
 #: A function head with calls or words after its parameter list (``GENERATE_TEST(a)`` /

@@ -566,6 +566,23 @@ def test_a_function_named_after_an_empty_macro_takes_the_head_macros_name() -> N
     ]
 
 
+def test_a_function_read_as_a_declaration_with_a_brace_initializer() -> None:
+    # gevent's libev.h: `static void f(struct s* p, t* w) {};` in a header, which
+    # tree-sitter-cpp reads as a declaration of f with a brace initializer, silently
+    facts = cpp(
+        """\
+        static void start_child(struct ev_loop* loop, child_t* w) {};
+
+        static int stop_child(int a) { return a ? 1 : 0; }
+        """
+    )
+    assert functions(facts) == {"start_child": (1, 1, 1, True), "stop_child": (3, 3, 2, False)}
+    assert messages(facts) == [
+        "line 1: 1 function read from tokens only, v_g estimated (a function's body read as"
+        " a brace initializer)"
+    ]
+
+
 def test_a_damaged_function_head_that_lost_nothing_is_not_warned_about() -> None:
     # zlib: `ZEXPORT` between the type and the name is an ERROR for tree-sitter; the
     # function, its statements and decisions are read all the same
