@@ -27,9 +27,12 @@ A function of lizard's is its invention (left out of "lizard's real functions") 
     c ? ir_khash(as, key) : 1;`` after lizard closed the function around it too early), or
     its parentheses hold an expression (``HWY_IF_CONSTEXPR(!k) {``);
   * it is one of our functions cut short: the same name, starting in its head, ending
-    before it (a brace initializer in ``noexcept(...)`` read as the body).
+    before it (a brace initializer in ``noexcept(...)`` read as the body);
+  * it is a class, a variable's brace initializer or a declaration and a later block
+    (an attribute macro after ``struct``, ``x ABSL_GUARDED_BY(mu){...};``, a prototype,
+    ``#endif``, then ``enum {``).
 
-Those last two are also no evidence against ours: a function of ours that covers one of
+Those last three are also no evidence against ours: a function of ours that covers one of
 them is not made up for it.
 """
 
@@ -231,6 +234,7 @@ def made_up(
                 and not any(s <= other.start and other.end <= e for s, e in local_classes)
                 and not keyword(other.name)
                 and not call_read_as_function(lines, other)
+                and not no_function(lines, other)
                 and not same_head(lines, function, other)
             ]
             if covered:
@@ -239,6 +243,8 @@ def made_up(
 
 
 _OPERATOR_BEFORE = re.compile(r"(?:[-=?(,+/%|^!]|(?<!:):|\breturn)\s*$")
+_CHAINED = re.compile(r"\s*->\s*(?!decltype\b)\w+\s*\(")
+_CLASS_KEYWORD = re.compile(r"\b(?:struct|union|class|enum)\b")
 _EXPRESSION = re.compile(r"!(?!=)|==|->|[A-Za-z_)]\.[A-Za-z_]")
 
 
@@ -283,7 +289,38 @@ def call_read_as_function(lines: list[str], other: Theirs) -> bool:
         inside.append(char)
         if depth == 0:
             break
-    return bool(_EXPRESSION.search("".join(inside)))
+    after = rest.lstrip()[len(inside) :]
+    return bool(_EXPRESSION.search("".join(inside)) or _CHAINED.match(after))
+
+
+def no_function(lines: list[str], other: Theirs) -> bool:
+    """Whether lizard's function ``other`` is a class, a variable's brace initializer or a
+    declaration followed by some block: its name is an attribute macro (in capitals, or
+    ``__attribute__``) after ``struct``/``union``/``class``/``enum`` (``struct
+    ABSL_DEPRECATED("...") Breakdown {``, ``typedef union __attribute__((packed)) U {``) or
+    whose braces close with ``};`` (``Tracker state_ ABSL_GUARDED_BY(mu_){"name", READY};``),
+    or a `;` ends its head before a class keyword and the `{` (``void ev_walk(...)
+    EV_NOEXCEPT;`` / ``#endif`` / ``enum {``)."""
+    if not 0 < other.start <= len(lines):
+        return False
+    short = other.name.rsplit("::", 1)[-1]
+    text = lines[other.start - 1]
+    at = text.find(short)
+    if at < 0:
+        return False
+    macro = short.startswith("__") or (short.upper() == short and any(c.isalpha() for c in short))
+    if macro and _CLASS_KEYWORD.search(text[:at]):
+        return True
+    body = "\n".join(lines[other.start - 1 : other.end])[at:]
+    if macro and re.search(r"\}\s*;\s*(?://.*)?$", body.rstrip()):
+        return True
+    head = body.split("{", 1)[0]
+    depth = 0
+    for index, char in enumerate(head):
+        depth += (char == "(") - (char == ")")
+        if char == ";" and depth == 0:
+            return bool(_CLASS_KEYWORD.search(head[index:] + "{"))
+    return False
 
 
 def _called(lines: list[str], function: Ours, name: str) -> bool:
@@ -307,6 +344,8 @@ def invention(
         return "keyword"
     if lines is not None and call_read_as_function(lines, other):
         return "a call read as a function"
+    if lines is not None and no_function(lines, other):
+        return "a class, an initializer or a declaration read as a function"
     if lines is not None and any(same_head(lines, f, other) for f in ours):
         return "the same function cut short"
     if other.start in defines:
