@@ -26,7 +26,8 @@ from archmetrics.parsers.c_family_heads import (
 )
 
 # a token: (kind, text, byte offset); kinds: w word, p directive, q string, n number,
-# o operator
+# o operator (a comparison is one: the `>=` of `enable_if_t<sizeof(a) >= 4, T>` closes no
+# template arguments and is no initializer's `=`)
 Token = tuple[str, bytes, int]
 
 _TOKENS = re.compile(
@@ -36,7 +37,7 @@ _TOKENS = re.compile(
     rb"|(?P<p>^[ \t]*+\#(?:[^\n\\/]++|\\.|/\*(?:[^*]|\*(?!/))*+(?:\*/|\Z)|/)*+)"
     rb"|(?P<w>[A-Za-z_$][\w$]*+)"
     rb"|(?P<n>\.?\d(?:[eEpP][-+]|['\w.])*+)"
-    rb"|(?P<o>::|->|&&|\|\||[^\s\w])",
+    rb"|(?P<o>::|->|&&|\|\||>>=|<<=|[<>=!]=|[^\s\w])",
     re.M | re.S,
 )
 _DIRECTIVE = re.compile(rb"[ \t]*+\#[ \t]*+(\w*)")

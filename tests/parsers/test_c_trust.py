@@ -583,6 +583,24 @@ def test_a_function_read_as_a_declaration_with_a_brace_initializer() -> None:
     ]
 
 
+def test_a_comparison_inside_template_arguments_of_a_return_type() -> None:
+    # Catch2: `std::enable_if_t<sizeof(R) >= sizeof(T), T> fill(G& g) {` is an ERROR for
+    # tree-sitter, and the token reading took `>=` for the closing `>` and an initializer's
+    # `=`: the function was lost under no warning
+    facts = cpp(
+        """\
+        template <typename T, typename G>
+            std::enable_if_t<sizeof(typename G::result_type) >= sizeof(T),
+            T> fill(G& gen) {
+            return gen() > 0 ? 1 : 0;
+        }
+        """
+    )
+    assert functions(facts) == {"fill": (1, 5, 2, True)}
+    [warning] = messages(facts)
+    assert warning.startswith("lines 1-5: 1 function read from tokens only, v_g estimated")
+
+
 def test_a_damaged_function_head_that_lost_nothing_is_not_warned_about() -> None:
     # zlib: `ZEXPORT` between the type and the name is an ERROR for tree-sitter; the
     # function, its statements and decisions are read all the same
