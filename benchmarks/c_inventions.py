@@ -300,7 +300,9 @@ def no_function(lines: list[str], other: Theirs) -> bool:
     ABSL_DEPRECATED("...") Breakdown {``, ``typedef union __attribute__((packed)) U {``) or
     whose braces close with ``};`` (``Tracker state_ ABSL_GUARDED_BY(mu_){"name", READY};``),
     or a `;` ends its head before a class keyword and the `{` (``void ev_walk(...)
-    EV_NOEXCEPT;`` / ``#endif`` / ``enum {``)."""
+    EV_NOEXCEPT;`` / ``#endif`` / ``enum {``), or its `{` stands inside its head's
+    parentheses (``static auto check(seq<I...>) -> decltype(all(seq<I...>{}, ...));``, a
+    declaration)."""
     if not 0 < other.start <= len(lines):
         return False
     short = other.name.rsplit("::", 1)[-1]
@@ -320,7 +322,7 @@ def no_function(lines: list[str], other: Theirs) -> bool:
         depth += (char == "(") - (char == ")")
         if char == ";" and depth == 0:
             return bool(_CLASS_KEYWORD.search(head[index:] + "{"))
-    return False
+    return depth > 0 and "{" in body  # `auto f() -> decltype(g(seq<I>{}))`: a declaration
 
 
 def _called(lines: list[str], function: Ours, name: str) -> bool:
@@ -344,10 +346,10 @@ def invention(
         return "keyword"
     if lines is not None and call_read_as_function(lines, other):
         return "a call read as a function"
-    if lines is not None and no_function(lines, other):
-        return "a class, an initializer or a declaration read as a function"
     if lines is not None and any(same_head(lines, f, other) for f in ours):
         return "the same function cut short"
+    if lines is not None and no_function(lines, other):
+        return "a class, an initializer or a declaration read as a function"
     if other.start in defines:
         return "inside a #define"
     inner = {f.start for f in theirs if other.start < f.start and f.end <= other.end}
