@@ -344,11 +344,15 @@ def invention(
     """The class of lizard's invention ``other`` is, or None for a real function."""
     if keyword(other.name):
         return "keyword"
-    if lines is not None and call_read_as_function(lines, other):
+    # the classes read from the text only for a function none of ours matches (a
+    # constructor lizard names after its last member initializer, `: data_(rhs.data_) {`,
+    # is a real one both report)
+    matched = any(f.end == other.end and f.start <= other.start for f in ours)
+    if lines is not None and not matched and call_read_as_function(lines, other):
         return "a call read as a function"
     if lines is not None and any(same_head(lines, f, other) for f in ours):
         return "the same function cut short"
-    if lines is not None and no_function(lines, other):
+    if lines is not None and not matched and no_function(lines, other):
         return "a class, an initializer or a declaration read as a function"
     if other.start in defines:
         return "inside a #define"
