@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from archmetrics.sources.git import READ_ONLY
+from archmetrics.sources.gitenv import READ_ONLY
 from archmetrics.sources.snapshot import (
     DirectorySnapshot,
     Snapshot,
