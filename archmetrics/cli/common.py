@@ -72,16 +72,21 @@ class RichProgress:
         self._status: Any = None  # a rich Status: the spinner of a step without a count
 
     def phase(self, description: str) -> None:
-        """A spinner and the step's name, until the next step."""
+        """A spinner and the step's name, until the next step (a name may hold a tag of
+        the repository's: never read as rich markup)."""
         self.stop()
-        self._status = self._console.status(f"{description} ...")
+        from rich.markup import escape
+
+        self._status = self._console.status(f"{escape(description)} ...")
         self._status.start()
 
     def start(self, description: str, total: int) -> None:
         self.stop()
         if total >= 20:
             self._bar.start()
-            self._task = self._bar.add_task(description, total=total)
+            from rich.markup import escape
+
+            self._task = self._bar.add_task(escape(description), total=total)
 
     def advance(self, count: int = 1) -> None:
         if self._task is not None:

@@ -433,7 +433,7 @@ def _markdown(repo: GitRepo, capsys: pytest.CaptureFixture[str], *extra: str) ->
 
 
 def _rows(markdown: str) -> list[str]:
-    return [line for line in markdown.splitlines() if line.startswith("| pkg/")]
+    return [line for line in markdown.splitlines() if line.startswith("| `pkg/")]
 
 
 def test_markdown_fits_a_pull_request_comment_and_says_what_it_left_out(
