@@ -134,12 +134,21 @@ def settings_at(root: Path, args: argparse.Namespace | None = None) -> Settings:
 
 
 def _with_excludes(
-    load: Callable[[Path, tuple[str, ...]], Settings], path: Path, args: argparse.Namespace | None
+    load: Callable[[Path, tuple[str, ...], bool], Settings],
+    path: Path,
+    args: argparse.Namespace | None,
 ) -> Settings:
+    """The settings ``load`` reads, with the command line's --exclude globs and, with
+    --allow-raised-limits, the configuration's limits above the defaults; each limit put
+    back to its default is a warning."""
     try:
-        return load(path, tuple(getattr(args, "exclude", None) or ()))
+        raised = bool(getattr(args, "allow_raised_limits", False))
+        settings = load(path, tuple(getattr(args, "exclude", None) or ()), raised)
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
+    for notice in settings.notices:
+        warn(notice)
+    return settings
 
 
 def emit(text: str, output: Path | None) -> None:

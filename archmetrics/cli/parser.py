@@ -42,6 +42,15 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
     add_exclude(parser)
 
 
+def add_allow_raised_limits(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--allow-raised-limits",
+        action="store_true",
+        help="let the configuration raise [limits] above their defaults (up to their ceilings);"
+        " without it a raised limit is put back to its default, with a warning",
+    )
+
+
 def add_exclude(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--exclude",
@@ -154,6 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
         " exit 1 when a function, file, element or the total fails it (repeatable)",
     )
     add_output(scan, [f.value for f in OutputFormat])
+    add_allow_raised_limits(scan)
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
@@ -172,6 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
+    add_allow_raised_limits(diff)
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -183,6 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(series)
     add_output(series, [f.value for f in OutputFormat])
     add_max_rows(series)
+    add_allow_raised_limits(series)
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
     )
@@ -196,6 +208,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    add_allow_raised_limits(compare)
     estimate = commands.add_parser(
         "estimate",
         help="price an integration before doing it: each architecture of a plan (TOML) or"
@@ -226,6 +239,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(estimate)
     add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
+    add_allow_raised_limits(estimate)
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )
@@ -262,6 +276,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
     add_exclude(graph)
+    add_allow_raised_limits(graph)
     docs = commands.add_parser(
         "docs", help="the documentation installed with archmetrics: list the pages, print one"
     )

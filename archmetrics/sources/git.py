@@ -166,6 +166,15 @@ class _BlobReader:
     def __init__(self, repo: git.Repo):
         self.repo = repo
 
+    def size(self, file: SourceFile) -> int | None:
+        """The blob's size, asked of git's long-lived ``cat-file --batch-check`` without
+        reading the blob (a file over the size limit is never read); None if git cannot
+        tell (reading it will say why)."""
+        try:
+            return int(self.repo.odb.info(bytes.fromhex(file.blob)).size)
+        except (GitCommandError, ValueError, GitError):
+            return None
+
     def read(self, file: SourceFile) -> bytes:
         try:
             data: bytes = self.repo.odb.stream(bytes.fromhex(file.blob)).read()

@@ -29,6 +29,8 @@ SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
         ('[tool.archmetrics]\nlanguages = { ".py" = "cobol" }\n', "no parser for language"),
         ("[tool.archmetrics]\ncache-path = '/'\n", "outside archmetrics's cache directory"),
         (b"\xff\xfe[tool]", "not valid TOML"),
+        ("[tool.archmetrics.limits]\nfile-mb = 1e-9\n", "limits.file-mb: expected at least 0.001"),
+        ('[tool.archmetrics]\ncache-path = "\\u0000"\n', "cache-path: expected a path (without"),
     ],
 )
 def test_a_bad_configuration_is_one_line(
