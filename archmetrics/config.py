@@ -136,6 +136,8 @@ class Settings:
     limits: LimitSettings = field(default_factory=LimitSettings)
     macros: MacroSettings = field(default_factory=MacroSettings)
     notices: tuple[str, ...] = ()  # what the run changed of these settings, said on stderr
+    revision: str | None = None  # the git revision they (and their rule packs) were read
+    # from; None: files on disk
 
 
 def _strings(value: Any, where: str) -> tuple[str, ...]:

@@ -24,7 +24,13 @@ from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.files import exclusion, pair_files
-from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.changeset.gates import (
+    UNMEASURED_GATE,
+    Gate,
+    check_gates,
+    parse_gate,
+    unmeasured_failure,
+)
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
@@ -66,6 +72,8 @@ class DiffRequest:
     gates: tuple[str, ...] = ()  # --fail-on, after the configured ones
     jobs: int = 0
     dynamic_pre_zero: bool = False
+    base_settings: Settings | None = None  # the base's, when ``settings`` are not (they
+    # came from the head or a file): what the implicit gate unmeasured(head) judges by
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,9 +91,12 @@ class DiffOptions:
     dynamic_pre_zero: bool
 
 
-def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
+def diff_options(
+    request: DiffRequest, root: Path, checkout: Checkout | None = None
+) -> DiffOptions:
     """The options of ``request`` for the repository at ``root`` (its rule packs are read
-    from there). A bad gate or rule pack fails here, before any work."""
+    from there, or from the revision the settings came from; ``checkout``: the repository,
+    if the caller opened it). A bad gate or rule pack fails here, before any work."""
     settings = request.settings
     limits = worker_limits(settings.limits, settings.macros)
     return DiffOptions(
@@ -96,7 +107,7 @@ def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
         limits=replace(limits, skip_generated=not settings.include_generated),
         jobs=request.jobs or settings.jobs,
         coupling=coupling_options(settings),
-        packs=rule_set(settings, root),
+        packs=rule_set(settings, root, checkout),
         dynamic_pre_zero=request.dynamic_pre_zero,
     )
 
@@ -296,22 +307,24 @@ def measure_change(
     cache: FactsCache | None = None,
     checkout: Checkout | None = None,
     options: DiffOptions | None = None,
+    sides: list[Side] | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """The change report between the two snapshots, and the parse warnings of both sides.
     ``checkout``: the repository, opened once by the caller (else opened here); ``options``:
-    the request's options, merged once by the caller (else here). Every step is named on
-    ``progress``: reading each side, parsing, coupling each tree, comparing the files."""
+    the request's options, merged once by the caller (else here); ``sides``, if given,
+    receives the base's and the head's side. Every step is named on ``progress``: reading
+    each side, parsing, coupling each tree, comparing the files."""
     progress = progress or NoProgress()
     progress.phase(f"reading {request.base} and {request.head}")
     checkout = checkout or open_checkout(request.root)
-    options = options or diff_options(request, checkout.root)
+    options = options or diff_options(request, checkout.root, checkout)
     snapshots = (checkout.snapshot(request.base), checkout.snapshot(request.head))
     opened = checkout
 
     def renames() -> Mapping[str, str]:
         return opened.renames(request.base, request.head)
 
-    return measure_snapshots(options, snapshots, renames, progress, cache)
+    return measure_snapshots(options, snapshots, renames, progress, cache, sides)
 
 
 def measure_snapshots(
@@ -320,6 +333,7 @@ def measure_snapshots(
     renames: Mapping[str, str] | Callable[[], Mapping[str, str]],
     progress: Progress | None = None,
     cache: FactsCache | None = None,
+    sides: list[Side] | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
     path, or how to ask for them when the head's state was not patched from the base's),
@@ -334,6 +348,8 @@ def measure_snapshots(
     finally:
         if delta is not None:
             delta.cancel()  # its git processes, if the head's state did not need them
+    if sides is not None:
+        sides[:] = [pre, post]
     if post.renames is not None:
         moved: Mapping[str, str] = post.renames
     else:
@@ -435,9 +451,21 @@ def run_diff(
     """Measure, then check the gates. ``checkout`` and ``options`` as for
     :func:`measure_change` (a series opens and merges once for all its stages)."""
     checkout = checkout or open_checkout(request.root)
-    options = options or diff_options(request, checkout.root)  # a bad gate fails before work
-    change, warnings = measure_change(request, progress, cache, checkout, options)
+    options = options or diff_options(request, checkout.root, checkout)  # a bad gate fails
+    # before any work
+    sides: list[Side] = []
+    change, warnings = measure_change(request, progress, cache, checkout, options, sides)
     gates = options.gates
-    report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
+    texts = tuple(g.text for g in gates)
+    report = DiffReport(request.base, request.head, change, warnings, texts)
     failures = check_gates(gates, report.summaries())
-    return DiffReport(report.base, report.head, change, warnings, report.gates, failures)
+    if gates:  # a gated diff: what the base's configuration measures, the head must too
+        from archmetrics.app.unmeasured import unmeasured_in_head
+
+        base = request.base_settings
+        judge = None if base is None else diff_options(replace(request, settings=base),
+                                                       checkout.root, checkout)  # fmt: skip
+        left = unmeasured_in_head(sides[0], sides[1], options, judge)
+        texts += (UNMEASURED_GATE,)
+        failures += (unmeasured_failure(left),) if left else ()
+    return DiffReport(report.base, report.head, change, warnings, texts, failures)

@@ -193,8 +193,8 @@ def run_estimate(
     ``actual``, measure base..actual too and the error of every estimated figure.
     ``checkout``: the repository, if the caller opened it already."""
     checkout = checkout or open_checkout(request.diff.root)
-    options = diff_options(request.diff, checkout.root)  # a bad gate or plan fails before
-    gates = options.gates  # any work
+    options = diff_options(request.diff, checkout.root, checkout)  # a bad gate or plan
+    gates = options.gates  # fails before any work
     plan = _selected(read_plan_file(request.plan), request)
     progress = progress or NoProgress()
     bases: dict[str, MeasuredBase] = {}

@@ -9,8 +9,20 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from archmetrics.config import LimitSettings, Settings, load_settings
+from archmetrics.config import (
+    CONFIG_FILES,
+    MAX_CONFIG_BYTES,
+    ConfigError,
+    LimitSettings,
+    Settings,
+    load_settings,
+    parse_toml,
+    settings_from_document,
+)
 from archmetrics.globs import compile_glob
+from archmetrics.reading import TooLarge, read_regular
+from archmetrics.sources.checkout import Checkout
+from archmetrics.sources.snapshot import WORKTREE
 
 _DEFAULT_LIMITS = LimitSettings()
 
@@ -37,6 +49,51 @@ def settings_at(
     """The settings of the repository or folder whose top is ``root`` (a command that has
     opened it already knows its top), with ``exclude`` as for :func:`settings_for`."""
     return merged(load_settings(root), exclude, allow_raised_limits)
+
+
+def settings_of(
+    checkout: Checkout,
+    spec: str | None,
+    exclude: Sequence[str] = (),
+    allow_raised_limits: bool = False,
+) -> Settings:
+    """The configuration of the snapshot ``spec`` names, merged as :func:`merged` says: a
+    revision's (or the index's) from its own ``archmetrics.toml`` / ``pyproject.toml``
+    blobs, its rule packs read from there too (``revision``); the files on disk for None
+    or WORKTREE; none (the defaults) for EMPTY or a revision without one."""
+    if spec is None or spec == WORKTREE or checkout.repo is None:
+        return merged(load_settings(checkout.root), exclude, allow_raised_limits)
+    found = Settings(source=f"{spec} (no configuration)", revision=spec)
+    for name in CONFIG_FILES:
+        data = checkout.file_at(spec, name, MAX_CONFIG_BYTES)
+        if data is None:
+            continue
+        source = f"{spec}:{name}"
+        settings = settings_from_document(parse_toml(data, source), name, source)
+        if settings is not None:
+            found = dataclasses.replace(settings, revision=spec)
+            break
+    return merged(found, exclude, allow_raised_limits)
+
+
+def settings_from_file(
+    path: Path, exclude: Sequence[str] = (), allow_raised_limits: bool = False
+) -> Settings:
+    """The configuration in the file ``path`` the runner names (``--config-from FILE``): a
+    ``pyproject.toml`` by that name (its ``[tool.archmetrics]``), else an
+    ``archmetrics.toml``; its rule packs are read from the files on disk."""
+    source = str(path)
+    try:
+        data = read_regular(path, MAX_CONFIG_BYTES)
+    except TooLarge:
+        raise ConfigError(f"{source}: larger than {MAX_CONFIG_BYTES} bytes; not read") from None
+    except OSError as error:
+        raise ConfigError(f"{source}: cannot read: {error.strerror or error}") from error
+    name = "pyproject.toml" if path.name == "pyproject.toml" else "archmetrics.toml"
+    settings = settings_from_document(parse_toml(data, source), name, source)
+    if settings is None:
+        raise ConfigError(f"{source}: no [tool.archmetrics] table")
+    return merged(settings, exclude, allow_raised_limits)
 
 
 def merged(

@@ -51,6 +51,17 @@ def add_allow_raised_limits(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_config_from(parser: argparse.ArgumentParser, base: str, head: str) -> None:
+    parser.add_argument(
+        "--config-from",
+        default="base",
+        metavar="base|head|FILE",
+        help=f"whose configuration decides what is measured and the gates: {base} (the"
+        f" default: a pull request cannot change them), {head}, or a TOML file of the"
+        " runner's (docs/ci.md)",
+    )
+
+
 def add_exclude(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--exclude",
@@ -183,6 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
     add_allow_raised_limits(diff)
+    add_config_from(diff, "--base's", "--head's")
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -195,6 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_output(series, [f.value for f in OutputFormat])
     add_max_rows(series)
     add_allow_raised_limits(series)
+    add_config_from(series, "the first stage's base (--root, or the first REV)", "the last REV's")
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
     )
@@ -209,6 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
     add_allow_raised_limits(compare)
+    add_config_from(compare, "each repository's first stage's base", "its last revision's")
     estimate = commands.add_parser(
         "estimate",
         help="price an integration before doing it: each architecture of a plan (TOML) or"
@@ -240,6 +254,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
     add_allow_raised_limits(estimate)
+    add_config_from(estimate, "--base's", "--head's (with --actual; else the work tree's)")
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )

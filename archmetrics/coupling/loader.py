@@ -13,6 +13,7 @@ import hashlib
 import os
 import tomllib
 from collections.abc import Iterable
+from dataclasses import dataclass
 from importlib import metadata, resources
 from importlib.resources.abc import Traversable
 
@@ -22,7 +23,21 @@ from archmetrics.reading import TooLarge, read_regular
 
 ENTRY_POINT_GROUP = "archmetrics.rulepacks"
 
-PackSource = str | os.PathLike[str] | Traversable
+
+
+@dataclass(frozen=True, slots=True)
+class PackBytes:
+    """A pack read already, e.g. from a git revision's blob: ``name`` is what errors and
+    reports call it (``v1:packs/ours.toml``)."""
+
+    name: str
+    data: bytes
+
+    def __str__(self) -> str:
+        return self.name
+
+
+PackSource = str | os.PathLike[str] | Traversable | PackBytes
 
 
 def builtin_pack_files() -> tuple[Traversable, ...]:
@@ -38,6 +53,10 @@ def load_rule_pack(source: PackSource) -> RulePack:
     try:
         if isinstance(source, str | os.PathLike):  # a file, not a resource in a package
             text = read_regular(source, MAX_PACK_BYTES).decode("utf-8")
+        elif isinstance(source, PackBytes):
+            if len(source.data) > MAX_PACK_BYTES:
+                raise TooLarge(name, len(source.data), MAX_PACK_BYTES)
+            text = source.data.decode("utf-8")
         else:
             text = source.read_text("utf-8")
     except TooLarge:

@@ -9,6 +9,7 @@ from operator import itemgetter
 from typing import Any
 
 from archmetrics.changeset.accuracy import Accuracy
+from archmetrics.changeset.gates import UnmeasuredFailure
 from archmetrics.changeset.model import ChangeReport
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.facts import ParseWarning
@@ -166,6 +167,12 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
         "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+        "unmeasured": [
+            {"path": path, "reason": why}
+            for failure in report.failures
+            if isinstance(failure, UnmeasuredFailure)
+            for path, why in failure.files
+        ],
     }
 
 

@@ -98,12 +98,14 @@ def test_the_caches_serve_the_same_links_and_know_the_rule_packs(
         'role = "use"\nendpoint = { type = "operation", key = "operation" }\n',
         "pyproject.toml": '[tool.archmetrics.coupling]\nrule-packs = ["pack.toml"]\n',
     })  # fmt: skip
-    mine = _diff(router, capsys, "--cache-path", cache)
+    config = ["--config-from", str(router.root / "pyproject.toml")]  # not committed
+    mine = _diff(router, capsys, "--cache-path", cache, *config)
     assert mine["locations"]["framework"]["delta_d_e"] == 2  # the route and the operation
     assert main(["cache", "info", "--cache-path", cache]) == 0
     capsys.readouterr()
 
 
+@pytest.mark.security
 def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
     tmp_path: Path,
 ) -> None:
@@ -123,6 +125,7 @@ def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
     assert checksums(tmp_path) == before
 
 
+@pytest.mark.security
 def test_a_huge_rules_file_is_over_the_file_limit_not_read(tmp_path: Path) -> None:
     (tmp_path / "pyproject.toml").write_text("[tool.archmetrics.limits]\nfile-mb = 0.01\n")
     (tmp_path / "rules.toml").write_text(ONE_ROUTE + '\n[[rules]]\nx = "y"\n' * 2_000)
