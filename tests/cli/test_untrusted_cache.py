@@ -9,6 +9,8 @@ import pytest
 from tests.gitrepo import GitRepo
 from tests.untrusted import checksums, run_cli
 
+pytestmark = pytest.mark.security
+
 SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 
 

@@ -12,6 +12,8 @@ import pytest
 from tests.gitrepo import GitRepo
 from tests.untrusted import run_cli
 
+pytestmark = pytest.mark.security
+
 SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 
 

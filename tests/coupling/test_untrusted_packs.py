@@ -13,6 +13,8 @@ from archmetrics.coupling import patterns
 from tests.gitrepo import GitRepo
 from tests.untrusted import run_cli
 
+pytestmark = pytest.mark.security
+
 PACK = """
 [pack]
 name = "ours"

@@ -304,6 +304,7 @@ def test_the_nesting_is_counted_on_the_tokens(source: str, depth: int, brackets:
     assert (found.depth, found.brackets) == (depth, brackets)
 
 
+@pytest.mark.security
 def test_every_pathological_input_completes_under_an_address_space_limit() -> None:
     """As ``ulimit -v 2000000`` would: the child must finish, measured or refused."""
     for source in (
