@@ -60,10 +60,12 @@ def confined(path: Path, *, must_exist: bool = False) -> Path:
         if top is None:  # the runner's own link (/dev/stdin, a folder of theirs)
             current = os.path.realpath(candidate)
             continue
-        try:
-            target = os.path.realpath(candidate, strict=True)
-        except OSError as error:  # a loop, a dangling link
-            raise SourceError(f"{path}: cannot resolve {candidate}: {error.strerror}") from None
+        target = os.path.realpath(candidate)
+        if _within(target, top):
+            try:
+                target = os.path.realpath(candidate, strict=True)
+            except OSError as error:  # a loop, a dangling link
+                raise SourceError(f"{path}: cannot resolve {candidate}: {error.strerror}") from None
         if not _within(target, top):
             raise SourceError(
                 f"{path}: {candidate} is a symbolic link leading out of {top} (to {target});"
