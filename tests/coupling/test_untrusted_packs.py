@@ -64,7 +64,7 @@ def test_a_backtracking_pattern_is_cut_off_and_reported(repo: GitRepo) -> None:
     assert all(s["endpoint"] is None and "gave up after" in s["note"] for s in sent)
     [served] = [s for s in sites if s["rule"] == "ours/serve"]
     assert served["endpoint"] == "name:work" and served["note"] is None
-    table = run_cli(["scan", ".", "--by", "link", "--no-cache"], repo.root)
+    table = run_cli(["scan", ".", "--by", "link", "--no-cache"], repo.root, {"COLUMNS": "300"})
     assert "gave up after" in table.out
 
 

@@ -140,7 +140,7 @@ def test_a_code_span_holds_any_text() -> None:
 def test_the_terminal_table_shows_names_as_they_are(repo: GitRepo) -> None:
     """rich reads ``[bold]`` and ``[link=...]`` as its markup unless told not to."""
     for argv in (["scan", "."], ["diff", "--base", "v1", "--head", TAG]):
-        run = run_main([*argv, "--no-cache"], repo.root)
+        run = run_main([*argv, "--no-cache"], repo.root, {"COLUMNS": "300"})  # no wrapping
         assert run.code == 0, run.err
         for name in ("[bold]gone[_bold].py", "[link=https:evil.example]hyper[_link].py"):
             assert name in run.out, run.out
