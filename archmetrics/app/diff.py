@@ -26,7 +26,13 @@ from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.files import exclusion, pair_files
-from archmetrics.changeset.gates import Gate, check_gates
+from archmetrics.changeset.gates import (
+    UNMEASURED_GATE,
+    Gate,
+    GateFailure,
+    check_gates,
+    unmeasured_failure,
+)
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
@@ -72,6 +78,8 @@ class DiffRequest:
     dynamic_pre_zero: bool = False
     base_label: str = ""  # how reports name the base (``A...B``), when not ``base`` itself
     baseline: Baseline | None = None  # offenders already known (--baseline FILE)
+    base_settings: Settings | None = None  # the base's, when ``settings`` are not (they
+    # came from the head or a file): what the implicit gate unmeasured(head) judges by
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,9 +98,12 @@ class DiffOptions:
     dynamic_pre_zero: bool
 
 
-def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
+def diff_options(
+    request: DiffRequest, root: Path, checkout: Checkout | None = None
+) -> DiffOptions:
     """The options of ``request`` for the repository at ``root`` (its rule packs are read
-    from there). A bad gate or rule pack fails here, before any work."""
+    from there, or from the revision the settings came from; ``checkout``: the repository,
+    if the caller opened it). A bad gate or rule pack fails here, before any work."""
     settings = request.settings
     limits = worker_limits(settings.limits, settings.macros)
     gates, unit_gates = split_gates((*settings.gates, *request.gates))
@@ -105,7 +116,7 @@ def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
         limits=replace(limits, skip_generated=not settings.include_generated),
         jobs=request.jobs or settings.jobs,
         coupling=coupling_options(settings),
-        packs=rule_set(settings, root),
+        packs=rule_set(settings, root, checkout),
         dynamic_pre_zero=request.dynamic_pre_zero,
     )
 
@@ -305,22 +316,24 @@ def measure_change(
     cache: FactsCache | None = None,
     checkout: Checkout | None = None,
     options: DiffOptions | None = None,
+    sides: list[Side] | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """The change report between the two snapshots, and the parse warnings of both sides.
     ``checkout``: the repository, opened once by the caller (else opened here); ``options``:
-    the request's options, merged once by the caller (else here). Every step is named on
-    ``progress``: reading each side, parsing, coupling each tree, comparing the files."""
+    the request's options, merged once by the caller (else here); ``sides``, if given,
+    receives the base's and the head's side. Every step is named on ``progress``: reading
+    each side, parsing, coupling each tree, comparing the files."""
     progress = progress or NoProgress()
     progress.phase(f"reading {request.base} and {request.head}")
     checkout = checkout or open_checkout(request.root)
-    options = options or diff_options(request, checkout.root)
+    options = options or diff_options(request, checkout.root, checkout)
     snapshots = (checkout.snapshot(request.base), checkout.snapshot(request.head))
     opened = checkout
 
     def renames() -> Mapping[str, str]:
         return opened.renames(request.base, request.head)
 
-    return measure_snapshots(options, snapshots, renames, progress, cache)
+    return measure_snapshots(options, snapshots, renames, progress, cache, sides)
 
 
 def measure_snapshots(
@@ -329,6 +342,7 @@ def measure_snapshots(
     renames: Mapping[str, str] | Callable[[], Mapping[str, str]],
     progress: Progress | None = None,
     cache: FactsCache | None = None,
+    sides: list[Side] | None = None,
 ) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
     """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
     path, or how to ask for them when the head's state was not patched from the base's),
@@ -343,6 +357,8 @@ def measure_snapshots(
     finally:
         if delta is not None:
             delta.cancel()  # its git processes, if the head's state did not need them
+    if sides is not None:
+        sides[:] = [pre, post]
     if post.renames is not None:
         moved: Mapping[str, str] = post.renames
     else:
@@ -445,17 +461,39 @@ def run_diff(
     """Measure, then check the gates. ``checkout`` and ``options`` as for
     :func:`measure_change` (a series opens and merges once for all its stages)."""
     checkout = checkout or open_checkout(request.root)
-    options = options or diff_options(request, checkout.root)  # a bad gate fails before work
-    change, warnings = measure_change(request, progress, cache, checkout, options)
+    options = options or diff_options(request, checkout.root, checkout)  # a bad gate fails
+    # before any work
+    sides: list[Side] = []
+    change, warnings = measure_change(request, progress, cache, checkout, options, sides)
     gates = options.gates
     label = request.base_label or request.base
     texts = (*(g.text for g in gates), *(t.text for t in options.unit_gates))
     report = DiffReport(label, request.head, change, warnings, texts)
     failures = check_gates(gates, report.summaries())
+    if gates or options.unit_gates:  # a gated diff: what the base's configuration
+        # measures, the head must measure too
+        failures += _unmeasured(request, checkout, options, sides)
+        texts += (UNMEASURED_GATE,)
     checked = check_units(options.unit_gates, touched_units(change), request.baseline)
     origins = gate_origins(request.settings, checkout.root)
     commits = (checkout.commit_id(request.base), checkout.commit_id(request.head))
     return replace(
-        report, failures=failures, offenders=checked.failures, suppressed=checked.suppressed,
-        baselined=checked.baselined, origins=origins, commits=commits,
+        report, gates=texts, failures=failures, offenders=checked.failures,
+        suppressed=checked.suppressed, baselined=checked.baselined, origins=origins,
+        commits=commits,
     )  # fmt: skip
+
+
+def _unmeasured(
+    request: DiffRequest, checkout: Checkout, options: DiffOptions, sides: list[Side]
+) -> tuple[GateFailure, ...]:
+    """The failure of the implicit gate unmeasured(head), if the head leaves unmeasured files
+    the base's configuration measures (judged by the base's settings when the run's came
+    from the head or a file)."""
+    from archmetrics.app.unmeasured import unmeasured_in_head
+
+    base = request.base_settings
+    judge = None if base is None else diff_options(replace(request, settings=base),
+                                                   checkout.root, checkout)  # fmt: skip
+    left = unmeasured_in_head(sides[0], sides[1], options, judge)
+    return (unmeasured_failure(left),) if left else ()

@@ -56,7 +56,7 @@ def run_series(
     pairs = stage_pairs(request)
     checkout = checkout or open_checkout(request.diff.root)  # once for all stages, as are
     # the options
-    options = diff_options(request.diff, checkout.root)
+    options = diff_options(request.diff, checkout.root, checkout)
     stages = []
     for label, base, head in pairs:
         stage = replace(request.diff, base=base, head=head)

@@ -42,6 +42,26 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
     add_exclude(parser)
 
 
+def add_allow_raised_limits(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--allow-raised-limits",
+        action="store_true",
+        help="let the configuration raise [limits] above their defaults (up to their ceilings);"
+        " without it a raised limit is put back to its default, with a warning",
+    )
+
+
+def add_config_from(parser: argparse.ArgumentParser, base: str, head: str) -> None:
+    parser.add_argument(
+        "--config-from",
+        default="base",
+        metavar="base|head|FILE",
+        help=f"whose configuration decides what is measured and the gates: {base} (the"
+        f" default: a pull request cannot change them), {head}, or a TOML file of the"
+        " runner's (docs/ci.md)",
+    )
+
+
 def add_exclude(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--exclude",
@@ -165,6 +185,7 @@ def add_history(commands: argparse._SubParsersAction[Parser]) -> None:
         "--workers", type=int, metavar="N", help="run on a local Dask cluster of N workers"
     )
     add_locations(history)
+    add_allow_raised_limits(history)
     add_chart(history)
     add_output(history, ["table", "json", "markdown", "csv"])
 
@@ -216,6 +237,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_output(scan, [f.value for f in OutputFormat])
     add_baseline(scan)
+    add_allow_raised_limits(scan)
     baseline = commands.add_parser(
         "baseline",
         help="write the offenders of thresholds to a file, so that scan and diff --baseline"
@@ -237,6 +259,7 @@ def build_parser() -> argparse.ArgumentParser:
     baseline.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     baseline.add_argument("--cache-path", type=Path, help="the facts cache file to use")
     add_exclude(baseline)
+    add_allow_raised_limits(baseline)
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
@@ -268,6 +291,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
     add_baseline(diff)
+    add_allow_raised_limits(diff)
+    add_config_from(diff, "--base's", "--head's")
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -279,6 +304,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(series)
     add_output(series, [f.value for f in OutputFormat])
     add_max_rows(series)
+    add_allow_raised_limits(series)
+    add_config_from(series, "the first stage's base (--root, or the first REV)", "the last REV's")
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
     )
@@ -292,6 +319,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    add_allow_raised_limits(compare)
+    add_config_from(compare, "each repository's first stage's base", "its last revision's")
     add_history(commands)
     estimate = commands.add_parser(
         "estimate",
@@ -323,6 +352,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(estimate)
     add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
+    add_allow_raised_limits(estimate)
+    add_config_from(estimate, "--base's", "--head's (with --actual; else the work tree's)")
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )
@@ -359,6 +390,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
     add_exclude(graph)
+    add_allow_raised_limits(graph)
     docs = commands.add_parser(
         "docs", help="the documentation installed with archmetrics: list the pages, print one"
     )

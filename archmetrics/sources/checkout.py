@@ -89,6 +89,19 @@ class Checkout:
 
         return frozenset() if self.repo is None else git.staged_paths(self.repo)
 
+    def file_at(self, spec: str, path: str, limit: int) -> bytes | None:
+        """The bytes of the file ``path`` (POSIX, from the top) at ``spec`` (a revision or
+        INDEX), None when there is none (``EMPTY``, a repository with no commit yet, or no
+        such file); SourceError for a symbolic link, a submodule or a file over ``limit``
+        bytes (revision_files.py)."""
+        from archmetrics.sources import git
+        from archmetrics.sources.revision_files import file_at
+
+        if self.repo is None or spec == EMPTY or git.effective_spec(self.repo, spec) == EMPTY:
+            return None
+        commit = INDEX if spec == INDEX else git.resolve(self.repo, spec)
+        return file_at(self.repo, commit, path, limit, spec)
+
     def tags(self) -> tuple[str, ...]:
         """The repository's tags, oldest first (``git.tags_in_order``)."""
         from archmetrics.sources import git

@@ -3,11 +3,13 @@
 Blobs are read through GitPython's object database, which keeps one long-lived
 ``git cat-file --batch`` process per repository instead of one subprocess per file.
 
-Nothing here writes to the repository, and nothing here reaches the network: every git
-command runs with :data:`READ_ONLY`, so git neither refreshes the index's stat cache (which
-rewrites ``.git/index`` and takes ``index.lock``) nor fetches objects a partial clone left
-out. A revision or object that is not in the clone is a one-line :class:`SourceError`
-saying so and how to fetch it (docs/security.md).
+Nothing here writes to the repository, reaches the network or runs a program the
+repository's configuration names: every git command runs with
+:func:`~archmetrics.sources.gitenv.safe_environment`, so git neither refreshes the index's
+stat cache (which rewrites ``.git/index`` and takes ``index.lock``), nor fetches objects a
+partial clone left out, nor runs ``core.fsmonitor``, filters or hooks. A revision or
+object that is not in the clone is a one-line :class:`SourceError` saying so and how to
+fetch it (docs/security.md).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from archmetrics.sources.gitdelta import (
     index_delta,
     worktree_delta,
 )
+from archmetrics.sources.gitenv import safe_environment
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import (
     EMPTY,
@@ -34,14 +37,6 @@ from archmetrics.sources.snapshot import (
 )
 
 EMPTY_TREE = "4b825dc642cb6eb9a060e54bf8d69288fbee4904"
-
-READ_ONLY = {
-    "GIT_OPTIONAL_LOCKS": "0",  # no index refresh, no index.lock
-    "GIT_NO_LAZY_FETCH": "1",  # a partial clone's missing objects are not fetched (git 2.44+)
-    "GIT_ALLOW_PROTOCOL": "",  # ... nor by older git: no transport is allowed at all
-    "GIT_TERMINAL_PROMPT": "0",  # never wait for a password
-}
-"""The environment of every git command archmetrics runs."""
 
 
 def is_repository(path: Path) -> bool:
@@ -55,7 +50,7 @@ def is_repository(path: Path) -> bool:
 
 
 def open_repository(path: Path) -> git.Repo:
-    """The repository holding ``path``, its git commands set to :data:`READ_ONLY`."""
+    """The repository holding ``path``, its git commands set to a safe environment."""
     repo = find_repository(path)
     if repo is None:
         if not path.exists():
@@ -65,19 +60,24 @@ def open_repository(path: Path) -> git.Repo:
 
 
 def find_repository(path: Path) -> git.Repo | None:
-    """The repository holding ``path`` (its git commands set to :data:`READ_ONLY`), or None
-    when no repository holds it; SourceError when one does but git cannot read it."""
+    """The repository holding ``path`` (its git commands set to the environment of
+    :func:`~archmetrics.sources.gitenv.safe_environment`: read-only, offline, no program of
+    the repository's configuration), or None when no repository holds it; SourceError when
+    one does but git cannot read it."""
     try:
         repo = git.Repo(path, search_parent_directories=True)
     except (InvalidGitRepositoryError, NoSuchPathError):
         return None
     except OSError as error:  # a symbolic-link loop, a folder we may not read
         raise SourceError(f"{path}: cannot read: {error.strerror or error}") from error
-    repo.git.update_environment(**READ_ONLY)
+    repo.git.update_environment(**safe_environment())
     try:  # git's own checks (ownership, a broken .git) fail here, not halfway through
         repo.git.execute(["git", "rev-parse", "--git-dir"])
+        names: str = repo.git.execute(["git", "config", "--list", "--name-only", "-z"])
     except GitCommandError as error:
         raise explain(repo, error, str(path)) from error
+    # the filter and diff drivers the configuration defines, each one's programs disabled
+    repo.git.update_environment(**safe_environment(names.split("\0")))
     return repo
 
 
@@ -192,6 +192,15 @@ def _ls(repo: git.Repo, *args: str) -> list[str]:
 class _BlobReader:
     def __init__(self, repo: git.Repo):
         self.repo = repo
+
+    def size(self, file: SourceFile) -> int | None:
+        """The blob's size, asked of git's long-lived ``cat-file --batch-check`` without
+        reading the blob (a file over the size limit is never read); None if git cannot
+        tell (reading it will say why)."""
+        try:
+            return int(self.repo.odb.info(bytes.fromhex(file.blob)).size)
+        except (GitCommandError, ValueError, GitError):
+            return None
 
     def read(self, file: SourceFile) -> bytes:
         try:
