@@ -12,15 +12,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from archmetrics.app.diff import (
-    DiffOptions,
-    DiffRequest,
-    diff_options,
-    measure_change,
-    parse_side,
-    parse_warnings,
-    site_memo,
-)
+from archmetrics.app.diff import measure_change, parse_side, parse_warnings
+from archmetrics.app.diff_cache import site_memo
+from archmetrics.app.diff_options import DiffOptions, DiffRequest, diff_options
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.settings import gate_origins
 from archmetrics.app.sketch import MeasuredBase, sketched

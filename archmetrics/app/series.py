@@ -10,7 +10,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest, diff_options, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest, diff_options
 from archmetrics.app.progress import Progress
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources import EMPTY

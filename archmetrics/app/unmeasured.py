@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from archmetrics.app.coupling import configuration_files
-from archmetrics.app.diff import DiffOptions
+from archmetrics.app.diff_options import DiffOptions
 from archmetrics.app.tree import Side
 from archmetrics.changeset.rows import FileRow
 from archmetrics.parsers import LanguageTable

@@ -15,7 +15,13 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from archmetrics.changeset.model import SUMMARY_FIELDS, Summary
-from archmetrics.complexity.thresholds import COMPARISON, OPERATORS, or_of_ands
+from archmetrics.complexity.thresholds import (
+    COMPARISON,
+    OPERATORS,
+    Threshold,
+    or_of_ands,
+    parse_threshold,
+)
 
 _CONDITION = re.compile(
     r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*" + COMPARISON
@@ -163,3 +169,14 @@ def unmeasured_failure(files: Iterable[tuple[str, str]]) -> UnmeasuredFailure:
     """The failure of :data:`UNMEASURED_GATE` for these (path, why) pairs."""
     found = tuple(files)
     return UnmeasuredFailure(Gate(UNMEASURED_GATE, ()), (("unmeasured(head)", len(found)),), found)
+
+
+def split_gates(texts: Iterable[str]) -> tuple[tuple[Gate, ...], tuple[Threshold, ...]]:
+    """Location gates and unit gates, each parsed (a bad one fails here, before any work)."""
+    gates, thresholds = [], []
+    for text in texts:
+        if is_unit_gate(text):
+            thresholds.append(parse_threshold(text))
+        else:
+            gates.append(parse_gate(text))
+    return tuple(gates), tuple(thresholds)

@@ -7,7 +7,8 @@ import os
 import sys
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.progress import NoProgress
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
@@ -237,7 +238,7 @@ def diff_request(
     config_head: str | None = None,
 ) -> DiffRequest:
     """The command line's diff, in the repository the command opened: flags and settings
-    are merged from here on once (``app.diff.diff_options``). The configuration is that of
+    are merged from here on once (``app.diff_options.diff_options``). The configuration is that of
     ``config_base`` and ``config_head`` (default: ``base``, ``head``) as ``--config-from``
     chooses."""
     settings, base_settings = configuration(

@@ -120,3 +120,20 @@ def open_checkout(path: Path) -> Checkout:
     if repo is None:
         return Checkout(path if path.is_dir() or not path.exists() else path.parent)
     return Checkout(git.toplevel(repo), repo)
+
+
+def open_snapshot(root: Path, spec: str | None) -> Snapshot:
+    """The snapshot ``spec`` names in the repository or directory at ``root``.
+
+    ``spec`` is None (the files on disk), ``EMPTY``, ``WORKTREE``, ``INDEX`` or any git revision.
+    A command that needs several opens the repository once
+    (:func:`open_checkout`) and asks it for each.
+    """
+    if spec == EMPTY:
+        return EmptySnapshot()
+    if spec is None:
+        from archmetrics.sources import git
+
+        if not git.is_repository(root):
+            return Checkout(root).snapshot(None)
+    return open_checkout(root).snapshot(spec)

@@ -26,6 +26,7 @@ from archmetrics.sources.gitdelta import (
     worktree_delta,
 )
 from archmetrics.sources.gitenv import safe_environment
+from archmetrics.sources.giterrors import explain, is_shallow
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import (
     EMPTY,
@@ -87,33 +88,6 @@ def toplevel(repo: git.Repo) -> Path:
     return Path(repo.working_tree_dir)
 
 
-def explain(repo: git.Repo, error: GitCommandError, doing: str) -> SourceError:
-    """A one-line error for a git command that failed, saying why where git says it."""
-    stderr = str(error.stderr or "")
-    if "dubious ownership" in stderr:
-        where = repo.working_tree_dir or repo.git_dir
-        return SourceError(
-            f"{where}: git refuses to read a repository owned by another user; if you trust "
-            f"it: git config --global --add safe.directory {where}"
-        )
-    if "promisor remote" in stderr or "lazy fetching disabled" in stderr:
-        return SourceError(
-            f"{doing}: the object is not in this partial clone and archmetrics does not fetch; "
-            "fetch it first (e.g. git fetch --refetch, or clone without --filter)"
-        )
-    if _is_shallow(repo):
-        return SourceError(
-            f"{doing}: not in this shallow clone; fetch the history first "
-            "(git fetch --unshallow, or fetch-depth: 0 in CI)"
-        )
-    last = stderr.strip().splitlines()[-1] if stderr.strip() else f"exit {error.status}"
-    return SourceError(f"{doing}: git failed: {last.removeprefix('stderr: ').strip()}")
-
-
-def _is_shallow(repo: git.Repo) -> bool:
-    return (Path(repo.git_dir) / "shallow").is_file()
-
-
 def resolve(repo: git.Repo, rev: str) -> str:
     """The commit id ``rev`` names, in any syntax git accepts (``@{-1}``, ``v1^{commit}``,
     ``HEAD@{yesterday}``); SourceError with a one-line message when it names none."""
@@ -122,7 +96,7 @@ def resolve(repo: git.Repo, rev: str) -> str:
             ["git", "rev-parse", "--verify", "--quiet", "--end-of-options", f"{rev}^{{commit}}"]
         )
     except GitCommandError as error:
-        if _is_shallow(repo):
+        if is_shallow(repo):
             raise SourceError(
                 f"unknown revision {rev!r} in this shallow clone: if it is older than the "
                 "clone's depth, fetch the history first (git fetch --unshallow, or "
@@ -144,7 +118,7 @@ def merge_base(repo: git.Repo, first: str, second: str) -> str:
     except GitCommandError as error:
         if error.status != 1 or str(error.stderr or "").strip():
             raise explain(repo, error, f"the merge base of {first} and {second}") from error
-        if _is_shallow(repo):
+        if is_shallow(repo):
             raise SourceError(
                 f"{first} and {second}: no merge base in this shallow clone; fetch the history"
                 " first (git fetch --deepen=200, or --unshallow; fetch-depth: 0 in CI)"

@@ -59,7 +59,7 @@ class _Git:
     def finish(self, started: tuple[list[str], subprocess.Popen[bytes]]) -> bytes:
         from git.exc import GitCommandError
 
-        from archmetrics.sources.git import explain
+        from archmetrics.sources.giterrors import explain
 
         command, process = started
         out, err = process.communicate()

@@ -30,7 +30,7 @@ def _entry(repo: gitpython.Repo, spec: str, path: str) -> tuple[str, str] | None
     """(mode, blob) of ``path`` at ``spec`` (a commit id or INDEX), None if it has none."""
     from git.exc import GitCommandError
 
-    from archmetrics.sources.git import explain
+    from archmetrics.sources.giterrors import explain
 
     if spec == INDEX:
         args = ["ls-files", "-s", "-z", "--", path]

@@ -249,22 +249,3 @@ def _walk_order(path: str) -> list[tuple[int, str]]:
     subfolders, each in name order."""
     *folders, name = path.split("/")
     return [(1, folder) for folder in folders] + [(0, name)]
-
-
-def open_snapshot(root: Path, spec: str | None) -> Snapshot:
-    """The snapshot ``spec`` names in the repository or directory at ``root``.
-
-    ``spec`` is None (the files on disk), ``EMPTY``, ``WORKTREE``, ``INDEX`` or any git revision.
-    A command that needs several opens the repository once
-    (:func:`~archmetrics.sources.checkout.open_checkout`) and asks it for each.
-    """
-    from archmetrics.sources.checkout import Checkout, open_checkout
-
-    if spec == EMPTY:
-        return EmptySnapshot()
-    if spec is None:
-        from archmetrics.sources import git
-
-        if not git.is_repository(root):
-            return Checkout(root).snapshot(None)
-    return open_checkout(root).snapshot(spec)

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.cli import main
 from archmetrics.config import load_settings
