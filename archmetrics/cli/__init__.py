@@ -20,7 +20,8 @@ from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
 from archmetrics.cli import baseline, docs, estimate, history, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError, check_paths
-from archmetrics.cli.parser import build_parser, settle_format
+from archmetrics.cli.options import settle_format
+from archmetrics.cli.parser import build_parser
 from archmetrics.complexity.thresholds import ThresholdError
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError

@@ -55,12 +55,15 @@ def history_command(args: argparse.Namespace) -> int:
         # the configuration on disk: the range's commits each have their own, and one
         # run measures every commit by one set of rules
         diff_request(args, checkout, config_base=WORKTREE, config_head=WORKTREE),
-        history_range(args), args.scheduler, args.workers,
+        history_range(args),
+        args.scheduler,
+        args.workers,
     )
     shown = OutputFormat.TABLE if fmt is HistoryFormat.TABLE else OutputFormat.JSON
-    with _history_cache(args, request.diff.settings) as cache, shown_progress(
-        shown, args.quiet
-    ) as progress:
+    with (
+        _history_cache(args, request.diff.settings) as cache,
+        shown_progress(shown, args.quiet) as progress,
+    ):
         report = run_history(request, progress, cache, checkout)
         progress.phase("writing the report")
         text = render_history(report, fmt, View(args.top, args.element))
