@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from archmetrics.coupling.rules import ConfigRule, EndpointSource, EndpointSpec, Rule, RuleSet
+from archmetrics.markup import code_span, table_cell
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,12 +93,10 @@ def rule_rows(rules: RuleSet) -> tuple[RuleRow, ...]:
     )
 
 
-def _cell(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ") or "-"
-
-
 def _code(text: str) -> str:
-    return f"`{_cell(text)}`" if text not in ("", "-") else "-"
+    """A cell: the pack's text as a code span (packs come from the repository:
+    archmetrics.markup), or ``-`` for none."""
+    return table_cell(code_span(text)) if text not in ("", "-") else "-"
 
 
 def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
@@ -105,7 +104,8 @@ def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
     lines: list[str] = []
     header = "| rule | language | match | kind | role | endpoint | requires |"
     for pack in rules.packs:
-        lines += [f"{heading} `{pack.name}`", "", pack.description, "", header,
+        description = code_span(pack.description)
+        lines += [f"{heading} {code_span(pack.name)}", "", description, "", header,
                   "|---|---|---|---|---|---|---|"]  # fmt: skip
         for row in (*map(rule_row, pack.rules), *map(config_row, pack.configuration)):
             cells = (row.rule, row.language, row.match, row.kind, row.role, row.endpoint,

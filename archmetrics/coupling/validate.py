@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import NoReturn
 
 from archmetrics.coupling.dynamic import normalize_callee
 from archmetrics.coupling.patterns import PatternError, compile_pattern
@@ -22,6 +19,9 @@ from archmetrics.coupling.rules import (
     RulePackError,
     SiteKind,
 )
+from archmetrics.coupling.validate_where import ID as _ID
+from archmetrics.coupling.validate_where import Where, rule_header
+from archmetrics.coupling.validate_where import list_of as _list
 from archmetrics.globs import BadPattern, compile_glob
 
 _PACK_KEYS = frozenset({"name", "description"})
@@ -33,59 +33,6 @@ _ENDPOINT_KEYS = frozenset(
     {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file"}
 )
 _HINT_KEYS = frozenset({"match", "arg", "keyword"})
-_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
-
-
-@dataclass(frozen=True, slots=True)
-class Where:
-    source: str
-    rule: str | None = None
-
-    def fail(self, key: str | None, problem: str) -> NoReturn:
-        raise RulePackError(self.source, self.rule, key, problem)
-
-    def table(self, value: object, key: str, allowed: frozenset[str]) -> Mapping[str, object]:
-        if not isinstance(value, Mapping):
-            self.fail(key, f"must be a table, got {type(value).__name__}")
-        for name in value:
-            if name not in allowed:
-                known = _list(allowed)
-                self.fail(f"{key}.{name}" if key else name, f"unknown key (known: {known})")
-        return value
-
-    def text(self, table: Mapping[str, object], key: str, default: str | None = None) -> str:
-        value = table.get(key, default)
-        if not isinstance(value, str) or (default is None and not value):
-            self.fail(key, "required non-empty string" if value is None else "must be a string")
-        return value
-
-    def texts(self, table: Mapping[str, object], key: str, required: bool) -> tuple[str, ...]:
-        value = table.get(key, [] if not required else None)
-        items = [value] if isinstance(value, str) else value
-        if not isinstance(items, list) or not all(isinstance(i, str) and i for i in items):
-            self.fail(key, "must be a string or a list of non-empty strings")
-        if required and not items:
-            self.fail(key, "must not be empty")
-        return tuple(str(i) for i in items)
-
-    def integer(self, table: Mapping[str, object], key: str) -> int | None:
-        value = table.get(key)
-        if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
-            self.fail(key, f"must be an integer, got {value!r}")
-        if isinstance(value, int) and key == "arg" and value < 0:
-            self.fail(key, "argument index must be >= 0")
-        return value
-
-    def choice(self, table: Mapping[str, object], key: str, allowed: frozenset[str],
-               default: str | None = None) -> str:  # fmt: skip
-        value = self.text(table, key, default)
-        if value not in allowed:
-            self.fail(key, f"{value!r} is not one of {_list(allowed)}")
-        return value
-
-
-def _list(values: frozenset[str]) -> str:
-    return ", ".join(sorted(values))
 
 
 def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
@@ -109,20 +56,6 @@ def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
             Where(source, ident).fail("id", "duplicate rule id in this pack")
         seen.add(ident)
     return RulePack(name, source, top.text(pack, "description", ""), rules, configuration)
-
-
-def rule_header(
-    raw: object, source: str, unnamed: str, keys: frozenset[str]
-) -> tuple[Where, Mapping[str, object], str]:
-    """A rule's table read with these ``keys``, the place errors name (the rule's id, or
-    ``unnamed`` when it has none) and its id, checked."""
-    rule_id = raw.get("id") if isinstance(raw, Mapping) else None
-    where = Where(source, rule_id if isinstance(rule_id, str) else unnamed)
-    table = where.table(raw, "", keys)
-    ident = where.text(table, "id")
-    if not _ID.match(ident):
-        where.fail("id", f"{ident!r} must be letters, digits and _.+-")
-    return where, table, ident
 
 
 def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
@@ -153,9 +86,7 @@ def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
     )
 
 
-def _examples(
-    where: Where, raw: object, languages: tuple[str, ...]
-) -> tuple[tuple[str, str], ...]:
+def _examples(where: Where, raw: object, languages: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
     """``example = "..."`` (in the rule's first language) or ``[rules.example]`` by language."""
     if raw is None:
         return ()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import shutil
+import textwrap
 from collections.abc import Sequence
 from typing import Literal
 
@@ -26,10 +27,16 @@ from archmetrics.reports.printable import shown_lines, shown_warnings
 
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
     """Render rich objects to a string (ANSI colours only when ``color``), as wide as the
-    terminal, or 160 columns when there is none."""
+    terminal, or 160 columns when there is none. Text is shown as it is: no rich markup
+    or emoji code in a name is read as one."""
     width = width or terminal_width()
     out = io.StringIO()
-    console = Console(file=out, force_terminal=color, width=width, no_color=not color)
+    # names come from the measured repository: rich must not read them as its markup
+    # ("[link=...]" is a terminal hyperlink, "[bold]" disappears) or emoji codes
+    console = Console(
+        file=out, force_terminal=color, width=width, no_color=not color, markup=False,
+        emoji=False,
+    )  # fmt: skip
     for item in renderables:
         console.print(item)
     return out.getvalue()
@@ -108,6 +115,11 @@ def rows_table(
 _NAME_WIDTH = 24  # characters of a row's name shown on one line before it wraps
 
 
+def legend_lines(legend: str) -> str:
+    """``legend: ...`` wrapped to the terminal's width (its lines joined by line breaks)."""
+    return textwrap.fill(f"legend: {legend}", terminal_width(), break_on_hyphens=False)
+
+
 def terminal_width() -> int:
     """The terminal's columns (at least 60), or 160 when there is none."""
     return max(60, shutil.get_terminal_size((160, 24)).columns)
@@ -132,7 +144,7 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
     extra += [f"note: {note}" for note in report.notes]
     legend = SCAN_LEGEND + (" " + ELEMENT_LEGEND if grouping == "element" else "")
-    extra += [f"legend: {legend}", *gate_lines(report)]
+    extra += [legend_lines(legend), *gate_lines(report)]
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
 
 
@@ -177,7 +189,7 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     detail = rows_table(title, diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
     unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
-    lines.append(f"legend: {DIFF_LEGEND}")
+    lines.append(legend_lines(DIFF_LEGEND))
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
