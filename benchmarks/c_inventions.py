@@ -253,8 +253,8 @@ def same_head(lines: list[str], function: Ours, other: Theirs) -> bool:
     head (before the line of its first `{`) and ending before it (lizard took a brace
     initializer in a ``noexcept(...)`` or ``decltype(...)`` for the body, or closed it at
     a `}` of one #if branch)."""
-    short = other.name.rsplit("::", 1)[-1]
-    if function.name.rsplit("::", 1)[-1] != short or not (
+    short = other.name.rsplit("::", 1)[-1].replace(" ", "")  # lizard: `operator ( )`
+    if function.name.rsplit("::", 1)[-1].replace(" ", "") != short or not (
         function.start <= other.start and other.end < function.end
     ):
         return False
