@@ -12,7 +12,6 @@ provider keeps serving. Frames past ``max_total`` are refused as they are read."
 from __future__ import annotations
 
 import json
-import shutil
 import textwrap
 import time
 from collections.abc import Callable, Iterator
@@ -27,7 +26,6 @@ from robosoa.transports.zmq_guard import budget as guard_budget
 from robosoa.transports.zmq_outlet import META
 from tests.robosoa.conftest import FAST
 from tests.robosoa.procs import PYTHON, Proc, free_port, start_location
-from tests.robosoa.test_cli import run
 from tests.robosoa.test_hostile_peers import robosoa_stats
 from tests.robosoa.util import eventually, raw_publisher
 
@@ -225,17 +223,6 @@ def test_consumers_and_subscribers_refuse_frames_past_max_total(
         assert figures[("wire", "broadcast")].errors == 1
         pub.close(0)
     router.close(0)
-
-
-@pytest.fixture(scope="module")
-def keys(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("keys")
-    done = run("keys", str(folder), "location", "alice")
-    assert done.returncode == 0, done.stderr
-    (folder / "allow").mkdir()
-    for who in ("location", "alice"):
-        shutil.copy(folder / f"{who}.key", folder / "allow")
-    return folder
 
 
 @pytest.mark.parametrize("curve", [False, True])
