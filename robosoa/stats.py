@@ -27,8 +27,9 @@ REASONS = {
     "bad-reply": "a federated location service's reply was malformed",
     "busy": "every federation worker was busy: a lookup was answered from local entries only",
     "truncated": "entries left out of a lookup reply to keep it within the frame limit",
-    "budget": "a peer connection was more than its byte budget ahead of the provider (a "
-              "message too large in all its frames): it was shut down, with what it queued",
+    "budget": "a peer connection was more than its byte budget ahead of the process (a "
+              "request, reply or broadcast too large in all its frames, or a queue the "
+              "process did not read): it was shut down, with what it queued",
 }
 
 

@@ -33,7 +33,7 @@ from robosoa.transports.base import (
     Unreachable,
 )
 from robosoa.transports.zmq_dealers import Dealers
-from robosoa.transports.zmq_guard import Guard
+from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard, Guarding, budget
 from robosoa.transports.zmq_inbox import ZmqInbox
 from robosoa.transports.zmq_sockets import check_endpoint, public
 from robosoa.transports.zmq_topics import Topics
@@ -62,7 +62,7 @@ class ZmqAdapter(ProtocolAdapter):
                                  options.curve_location)
         self._auth: ThreadAuthenticator | None = None
         self._keys: dict[str, bytes] = {}  # endpoint -> its server's CURVE key (from lookups)
-        self._guard: Guard | None = None  # bounds what each provider connection holds
+        self._guard: Guard | None = None  # bounds what each peer connection makes us hold
 
     # --- SOA_Base ---------------------------------------------------------------------
     def configure(self) -> None:
@@ -71,9 +71,14 @@ class ZmqAdapter(ProtocolAdapter):
             if self._curve is not None:  # the ZAP handler first: nothing binds without it
                 self._auth = self._curve.authenticator(self._ctx)
             setup = self._secure if self._curve is not None else None
-            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing, setup)
+            self._guard = Guard()  # its thread starts with the first connection it watches
+            guarding = Guarding(self._guard, budget(self.options.total),
+                                FRAMING if self._curve is None else CURVE_FRAMING)
+            self._dealers = Dealers(self._ctx, self.options, lambda: self._closing, setup,
+                                    guarding, self._cut_reply)
             self._topics = Topics(self._ctx, self.endpoint, self.options, self.location,
-                                  self.rejected, self._lost, self._curve)
+                                  self.rejected, self._lost, self._curve,
+                                  guarding, lambda peer: self._budget("broadcast"))
 
     def _secure(self, sock: zmq.Socket[bytes], endpoint: str) -> None:
         """CURVE client set-up of a DEALER: the server key of ``endpoint``."""
@@ -259,14 +264,17 @@ class ZmqAdapter(ProtocolAdapter):
     def open_inbox(self, instance: str) -> Inbox:
         if self._ctx is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        if self._guard is None:
-            self._guard = Guard()
         return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected, self._curve,
-                        self._guard, self._cut)
+                        self._guard, lambda peer: self._budget("inbox"))
 
-    def _cut(self, peer: str) -> None:
-        """A provider connection from ``peer`` was shut down for holding too much."""
-        self.stats_book.counter("inbox", "wire").drop("budget")
+    def _cut_reply(self, endpoint: str) -> None:
+        """A DEALER's connection to ``endpoint`` was shut down for holding too much."""
+        self._budget("location" if endpoint == self.endpoint else "reply")
+
+    def _budget(self, where: str) -> None:
+        """Count a peer connection shut down for being more than its budget ahead of us
+        (role ``wire``, key ``where``: inbox, reply, location, broadcast)."""
+        self.stats_book.counter(where, "wire").drop("budget")
 
     def _live_topics(self) -> Topics:
         if self._topics is None or not self.connected:

@@ -2,7 +2,8 @@
 
 ``Unreachable``: the message could not be handed over (no connection within the wait, or a
 connection that was up is gone). ``Lost``: it was handed over, and the connection went away
-before the reply came (the peer died, or ZMTP heartbeats stopped coming back). DEALERs use
+before the reply came (the peer died, or ZMTP heartbeats stopped coming back, or the guard
+shut the connection down: a reply more than its budget ahead, see zmq_guard). DEALERs use
 ``IMMEDIATE``, so ZeroMQ keeps an outgoing pipe only while its connection is up: a DEALER
 that cannot be written to has no live connection, which is how both are noticed.
 """
@@ -17,17 +18,18 @@ from typing import Any
 
 import zmq
 
+from robosoa.blobs import MAX_BLOBS
 from robosoa.errors import BusClosed
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions, Lost, Unreachable
-from robosoa.transports.zmq_sockets import keepalive, limit_input, recv_rest, send_frames
+from robosoa.transports.zmq_guard import Guarding, Watch
+from robosoa.transports.zmq_sockets import keepalive, limit_input, recv_message, send_frames
 from robosoa.wire import LimitExceeded
 
 SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
 SLICE_MS = int(SLICE * 1000) + 1
 SOCKETS_PER_THREAD = 64  # consumer DEALERs kept per thread (least recently used closed)
 _NOBLOCK = int(zmq.NOBLOCK)  # plain ints: pyzmq's flag enums cost a little on every send
-_RCVMORE = int(zmq.RCVMORE)
 _EVENTS = int(zmq.EVENTS)
 _POLLOUT = int(zmq.POLLOUT)
 
@@ -35,14 +37,20 @@ Setup = Callable[[zmq.Socket[bytes], str], None]  # e.g. CURVE keys for the endp
 
 
 class Dealers:
-    """DEALER sockets of one bus, per thread; ``closing`` ends every wait within a slice."""
+    """DEALER sockets of one bus, per thread; ``closing`` ends every wait within a slice.
+    With ``guarding``, every DEALER's connection is bounded to its budget ahead of what the
+    thread took from it; ``cut`` is told the endpoint of each one shut down."""
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], options: BusOptions,
-                 closing: Callable[[], bool], setup: Setup | None = None) -> None:
+                 closing: Callable[[], bool], setup: Setup | None = None,
+                 guarding: Guarding | None = None,
+                 cut: Callable[[str], None] = lambda endpoint: None) -> None:
         self._ctx = ctx
         self._options = options
         self._closing = closing
         self._setup = setup
+        self._guarding = guarding
+        self._cut = cut
         self._local = threading.local()
         self._sockets: set[zmq.Socket[bytes]] = set()
         self._lock = threading.Lock()
@@ -52,6 +60,7 @@ class Dealers:
         if cache is None:
             cache = self._local.dealers = OrderedDict()
             self._local.live = set()
+            self._local.watches = {}
         return cache
 
     def _dealer(self, endpoint: str) -> zmq.Socket[bytes]:
@@ -73,6 +82,9 @@ class Dealers:
         keepalive(sock, options.link_heartbeat, options.link_timeout)
         if self._setup is not None:
             self._setup(sock, endpoint)
+        if self._guarding is not None:  # before connecting: the monitor sees the connection
+            self._local.watches[endpoint] = self._guarding.watch(
+                sock, lambda peer: self._cut(endpoint))
         sock.connect(endpoint)
         cache[endpoint] = sock
         with self._lock:
@@ -85,6 +97,7 @@ class Dealers:
         """Close this thread's socket to ``endpoint`` (after a failure, or to make room)."""
         sock = self._cache().pop(endpoint, None)
         self._local.live.discard(endpoint)
+        self._local.watches.pop(endpoint, None)
         if sock is not None:
             with self._lock:
                 self._sockets.discard(sock)
@@ -122,6 +135,8 @@ class Dealers:
         Blocks in ``recv`` with a receive timeout (no poller: cheaper on the hot path), in
         slices; after each empty slice the socket is asked whether its connection is up.
         """
+        watch: Watch | None = self._local.watches.get(endpoint)
+        limit, total = MAX_BLOBS + 1, self._options.total
         while True:
             remaining = deadline - time.monotonic()
             if remaining <= 0 or self._closing():
@@ -130,23 +145,29 @@ class Dealers:
             if wait != SLICE_MS:  # the socket is created with SLICE; shorter waits set it
                 sock.setsockopt(zmq.RCVTIMEO, wait)
             try:
-                data = sock.recv()
+                frames: list[bytes] | None = recv_message(sock, 0, limit, total, watch)
             except zmq.Again:
-                if not int(sock.getsockopt(_EVENTS)) & _POLLOUT:  # no pipe: connection gone
-                    self.drop(endpoint)
-                    raise Lost(f"connection to {endpoint} lost") from None
+                self._alive(sock, endpoint, watch)
                 continue
+            except LimitExceeded:  # more than max_total in all its frames: read, not kept
+                frames = None
             finally:
                 if wait != SLICE_MS:
                     sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-            try:
-                frames: list[bytes] | None = (recv_rest(sock, data, total=self._options.total)
-                                              if sock.getsockopt(_RCVMORE) else [data])
-            except LimitExceeded:  # more than max_total in all its frames: read, not kept
-                frames = None
             found = accept(frames)
             if found is not None:
                 return found
+
+    def _alive(self, sock: zmq.Socket[bytes], endpoint: str, watch: Watch | None) -> None:
+        """After an empty slice: Lost if the connection was shut down by the guard or is
+        gone (the socket has no pipe to write to)."""
+        if watch is not None and watch.cuts:
+            self.drop(endpoint)
+            raise Lost(f"connection to {endpoint} shut down: a reply more than "
+                       f"{watch.budget} bytes ahead") from None
+        if not int(sock.getsockopt(_EVENTS)) & _POLLOUT:
+            self.drop(endpoint)
+            raise Lost(f"connection to {endpoint} lost") from None
 
     def close(self) -> None:
         """Close every socket of every thread (the bus is shutting down)."""

@@ -106,6 +106,7 @@ class Watch:
     budget: int
     framing: int
     cut: Callable[[str], None]  # told the remote address of each connection shut down
+    cuts: int = 0  # connections shut down so far
     taken: dict[int, int] = field(default_factory=dict)
     connections: dict[int, _Connection] = field(default_factory=dict)
     fds: dict[bytes, int] = field(default_factory=dict)  # a ROUTER's peer (routing id) -> fd
@@ -177,6 +178,7 @@ class Watch:
         except OSError:
             peer = ("?",)
         self.forget(fd)
+        self.cuts += 1
         address = str(peer[0]) if isinstance(peer, tuple) else str(peer)
         log.warning("connection cut: more than its budget ahead of the application",
                     extra={"peer": address, "budget": self.budget, "ahead": ahead})
@@ -184,7 +186,8 @@ class Watch:
 
 
 class Guard:
-    """One thread checking the connections of every socket handed to :meth:`watch`."""
+    """One thread checking the connections of every socket handed to :meth:`watch`; none
+    until the first socket is."""
 
     def __init__(self) -> None:
         self._watches: list[Watch] = []
@@ -257,3 +260,17 @@ class Guard:
             for watch in self._watches:
                 watch.close()
             self._watches.clear()
+
+
+@dataclass(frozen=True, slots=True)
+class Guarding:
+    """How a bus guards the sockets that receive from peers: its guard thread, the budget of
+    one connection and ZMTP's framing around a frame (plain or CURVE)."""
+
+    guard: Guard
+    budget: int
+    framing: int
+
+    def watch(self, sock: zmq.Socket[bytes], cut: Callable[[str], None]) -> Watch | None:
+        """:meth:`Guard.watch` with this budget and framing (before ``sock`` connects)."""
+        return self.guard.watch(sock, self.budget, self.framing, cut)

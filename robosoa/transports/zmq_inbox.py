@@ -85,11 +85,16 @@ class ZmqInbox(Inbox):
             send_frames(router, out, _NOBLOCK)
 
         try:
-            frames = ([data] if not router.getsockopt(_RCVMORE) else
-                      recv_rest(router, data, total=self._options.total))
-            if watch is not None:
-                size = len(data) if len(frames) == 1 else sum(map(len, frames))
-                watch.took(identity, size, len(frames), first)
+            if not router.getsockopt(_RCVMORE):
+                frames = [data]
+                if watch is not None:
+                    watch.took(identity, len(data), 1, first)
+            elif watch is None:
+                frames = recv_rest(router, data, total=self._options.total)
+            else:  # credited refused or not: the connection's bytes were taken either way
+                frames = recv_rest(router, data, total=self._options.total,
+                                   took=lambda size, count: watch.took(identity, size, count,
+                                                                       first))
             if len(frames) == 1 and data == self._token:
                 return None
             msg = decode_frames(frames, self._options.max_message, self._options.max_depth,

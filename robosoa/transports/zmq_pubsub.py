@@ -28,6 +28,7 @@ from robosoa.errors import InvalidMessage
 from robosoa.message import Message, decode, decode_frames
 from robosoa.transports.base import BusOptions, Sink, hand_out
 from robosoa.transports.zmq_curve import Curve
+from robosoa.transports.zmq_guard import Guarding, Watch
 from robosoa.transports.zmq_outlet import MARK, META, prefix
 from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_message
 from robosoa.wire import LimitExceeded
@@ -48,8 +49,11 @@ class Feed:
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], options: BusOptions,
                  rejected: Callable[[str], None], lost: Callable[[str, int], None],
                  announce: str, announced: Callable[[], None],
-                 curve: Curve | None = None) -> None:
+                 curve: Curve | None = None, guarding: Guarding | None = None,
+                 cut: Callable[[str], None] = lambda peer: None) -> None:
         self._curve = curve
+        self._guarding = guarding  # each publisher connection: its budget ahead, then cut
+        self._cut = cut
         self._ctx = ctx
         self._options = options
         self._rejected = rejected  # counts malformed broadcasts (dropped: nobody to answer)
@@ -206,16 +210,18 @@ class Feed:
         if last is None or seq > last or not mark:
             self._last[key] = seq
 
-    def _socket(self) -> zmq.Socket[bytes]:
+    def _socket(self) -> tuple[zmq.Socket[bytes], Watch | None]:
+        """A SUB socket, and the guard's watch on its connections (before any is made)."""
         sub = self._ctx.socket(zmq.SUB)
         sub.setsockopt(zmq.LINGER, 0)
         sub.setsockopt(zmq.RCVHWM, self._options.hwm)
         limit_input(sub, self._options.max_message)
         keepalive(sub, self._options.link_heartbeat, self._options.link_timeout)
-        return sub
+        guarding = self._guarding
+        return sub, None if guarding is None else guarding.watch(sub, self._cut)
 
     def _run(self) -> None:
-        lossy, reliable = self._socket(), self._socket()
+        (lossy, watch), (reliable, reliable_watch) = self._socket(), self._socket()
         lossy.setsockopt(zmq.SUBSCRIBE, ANNOUNCE + b"\0")
         self._connect(lossy, self._announce, self._curve.location if self._curve else b"")
         peers: tuple[set[str], set[str]] = (set(), set())
@@ -230,9 +236,9 @@ class Feed:
                     self._waker.drain()
                     self._apply((lossy, reliable), peers)
                 if lossy in events:
-                    self._drain(lossy)
+                    self._drain(lossy, watch)
                 if reliable in events and self._held is None:
-                    self._drain_reliable(reliable)
+                    self._drain_reliable(reliable, reliable_watch)
                 if paused != (self._held is not None):  # hold the reliable socket back
                     paused = not paused
                     poller.modify(reliable, 0 if paused else zmq.POLLIN)
@@ -244,7 +250,7 @@ class Feed:
                 if done is not None:
                     done.set()
 
-    def _drain(self, sub: zmq.Socket[bytes]) -> None:
+    def _drain(self, sub: zmq.Socket[bytes], watch: Watch | None = None) -> None:
         """Deliver what the best-effort socket holds in batches, read and decoded first and
         handed out together (a subscription's reader is woken once per batch, not every few
         messages), or as soon as they hold ``BATCH_BYTES`` (so large messages go one by one,
@@ -254,7 +260,7 @@ class Feed:
         total = self._options.total
         for _ in range(BATCH):  # then look at commands again
             try:
-                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, total)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, total, watch)
             except zmq.Again:
                 break
             except LimitExceeded:  # read, not kept
@@ -273,12 +279,13 @@ class Feed:
                     gathered = 0
         _hand_out(batch)
 
-    def _drain_reliable(self, sub: zmq.Socket[bytes]) -> None:
+    def _drain_reliable(self, sub: zmq.Socket[bytes], watch: Watch | None = None) -> None:
         """Deliver what the reliable socket holds, one message at a time; stop at a
         message a subscription refused (held back until it has room)."""
         for _ in range(BATCH):
             try:
-                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, self._options.total)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, self._options.total,
+                                      watch)
             except zmq.Again:
                 return
             except LimitExceeded:  # read, not kept

@@ -21,6 +21,7 @@ from robosoa.location import PUBLISHERS, ServiceInfo
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions, Sink
 from robosoa.transports.zmq_curve import Curve
+from robosoa.transports.zmq_guard import Guarding
 from robosoa.transports.zmq_outlet import RELIABLE, Outlet
 from robosoa.transports.zmq_pubsub import Feed
 
@@ -73,8 +74,12 @@ class Topics:
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str, options: BusOptions,
                  ask: Location, rejected: Callable[[str], None],
-                 lost: Callable[[str, int], None], curve: Curve | None = None) -> None:
+                 lost: Callable[[str, int], None], curve: Curve | None = None,
+                 guarding: Guarding | None = None,
+                 cut: Callable[[str], None] = lambda peer: None) -> None:
         self._curve = curve
+        self._guarding = guarding  # bounds what each publisher's connection holds
+        self._cut = cut
         self._ctx = ctx
         self._location = location
         self._options = options
@@ -131,7 +136,8 @@ class Topics:
             with self._lock:
                 if self._feed is None:
                     self._feed = Feed(self._ctx, self._options, self._rejected, self._lost,
-                                      self.announce, self._announced, self._curve)
+                                      self.announce, self._announced, self._curve,
+                                      self._guarding, self._cut)
                     self._discovery = Discovery(self._publishers, self._connected,
                                                 max(0.1, self._options.heartbeat))
                 feed = self._feed

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import shutil
+import subprocess
 import uuid
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
 import robosoa
-from tests.robosoa.procs import Proc, tcp_location
+from tests.robosoa.procs import PYTHON, REPO, Proc, _env, tcp_location
 
 FAST = {"heartbeat": 0.2, "ttl": 1.0, "lookup_cache": 0.2, "location_timeout": 2.0}
 
@@ -49,3 +52,17 @@ def pair(url: str) -> Iterator[tuple[robosoa.Bus, robosoa.Bus]]:
 def name() -> str:
     """A service/topic name no other test uses (the zmq location service is shared)."""
     return f"svc-{uuid.uuid4().hex[:8]}"
+
+
+@pytest.fixture(scope="module")
+def keys(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """CURVE key pairs of ``location`` and ``alice`` (``robosoa keys``), both public keys
+    in the folder ``allow``."""
+    folder = tmp_path_factory.mktemp("keys")
+    done = subprocess.run([PYTHON, "-m", "robosoa", "keys", str(folder), "location", "alice"],
+                          capture_output=True, text=True, env=_env(), cwd=REPO, timeout=30)
+    assert done.returncode == 0, done.stderr
+    (folder / "allow").mkdir()
+    for who in ("location", "alice"):
+        shutil.copy(folder / f"{who}.key", folder / "allow")
+    return folder

@@ -12,7 +12,6 @@ provider keeps serving. Frames past ``max_total`` are refused as they are read."
 from __future__ import annotations
 
 import json
-import shutil
 import textwrap
 import time
 from collections.abc import Callable, Iterator
@@ -27,7 +26,6 @@ from robosoa.transports.zmq_guard import budget as guard_budget
 from robosoa.transports.zmq_outlet import META
 from tests.robosoa.conftest import FAST
 from tests.robosoa.procs import PYTHON, Proc, free_port, start_location
-from tests.robosoa.test_cli import run
 from tests.robosoa.test_hostile_peers import robosoa_stats
 from tests.robosoa.util import eventually, raw_publisher
 
@@ -227,17 +225,6 @@ def test_consumers_and_subscribers_refuse_frames_past_max_total(
     router.close(0)
 
 
-@pytest.fixture(scope="module")
-def keys(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("keys")
-    done = run("keys", str(folder), "location", "alice")
-    assert done.returncode == 0, done.stderr
-    (folder / "allow").mkdir()
-    for who in ("location", "alice"):
-        shutil.copy(folder / f"{who}.key", folder / "allow")
-    return folder
-
-
 @pytest.mark.parametrize("curve", [False, True])
 def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) -> None:
     """The guard's count of what was taken must keep up with what arrived: 150 requests and
@@ -268,4 +255,33 @@ def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) ->
             drops = {(f.role, f.key): dict(f.drops) for f in provider.stats()}
             assert drops.get(("wire", "inbox"), {}).get("budget", 0) == 0
     finally:
+        proc.stop()
+
+
+def test_refused_messages_are_credited_to_their_connection(
+        zmq_url: str, name: str, ctx: zmq.Context[zmq.Socket[bytes]]) -> None:
+    """A message refused for its size was still taken from its connection: six of 4.6 MB
+    through one connection (27.6 MB, past its 16 MiB budget if they were not counted) are
+    answered with errors, and the connection is never cut."""
+    proc, endpoint, _ = provider(zmq_url, name, max_message=MIB, max_total=4 * MIB)
+    sock = ctx.socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.connect(endpoint)
+    data = b"x" * (900 * 1024)
+    try:
+        sock.send(b"")  # answered with an error: connected, and watched from the next check
+        assert sock.poll(10_000)
+        sock.recv()
+        time.sleep(0.5)
+        for n in range(6):
+            head = {"kind": "request", "service": name, "operation": "size", "id": str(n),
+                    "payload": {"d": [None] * 5}, "blobs": [["d", i] for i in range(5)]}
+            sock.send_multipart([json.dumps(head).encode(), *[data] * 5], copy=False)
+            assert sock.poll(30_000), f"no answer to message {n}"
+            reply = json.loads(sock.recv())
+            assert reply["context"]["error_type"] == "InvalidMessage", reply
+            time.sleep(0.2)  # the guard takes the monitor's news and checks meanwhile
+        assert cuts(zmq_url, "wire", "inbox") == 0
+    finally:
+        sock.close(0)
         proc.stop()
