@@ -78,7 +78,12 @@ class Function(NamedTuple):
 
     ``parameters``: the names of its parameters in the order written (Python's ``*args``
     and ``**kw`` as ``args`` and ``kw``, ``self`` included; C's ``void`` list is empty),
-    so that a value can be traced from a call's argument to the parameter it binds."""
+    so that a value can be traced from a call's argument to the parameter it binds.
+
+    ``estimated``: the parser's syntax tree could not read all of it, and its decisions
+    (all of them, when the tree lost the whole function) were counted by a reading of its
+    tokens instead; its v_g is then an estimate, and its statements and call sites may be
+    incomplete (a warning of the file names the lines; docs/metrics.md, "Warnings")."""
 
     name: str
     qualified_name: str
@@ -89,6 +94,7 @@ class Function(NamedTuple):
     # the fields a reviewer's `archmetrics: ignore[vg]` comment exempts it from ("*": all);
     # it changes no number, only which thresholds and gates the function can fail
     suppressed: tuple[str, ...] = ()
+    estimated: bool = False
 
     @property
     def complexity(self) -> int:

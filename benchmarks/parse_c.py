@@ -1,6 +1,6 @@
 """CPU time of the C/C++ parser alone over the oracle corpora, for a before/after comparison.
 
-    python benchmarks/parse_c.py [--checkout DIR] [--repeat N] NAME ...
+    python benchmarks/parse_c.py [--checkout DIR] [--repeat N] [--every N] NAME ...
 
 Parses every C/C++ file of the named corpora of benchmarks/oracle_c.py (fetched as it
 fetches them) in one process, ``--repeat`` times, and prints the best CPU time. ``--checkout``
@@ -24,6 +24,9 @@ def main() -> None:
     parser.add_argument("--checkout", type=Path, default=ROOT)
     parser.add_argument("--corpus", type=Path, default=ROOT / ".cache" / "corpus13")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument(
+        "--every", type=int, default=1, help="only every Nth file (a sample for callgrind)"
+    )
     args = parser.parse_args()
     sys.path.insert(0, str(args.checkout))
     from archmetrics.parsers import c_family  # before oracle_c, which puts ROOT on the path
@@ -35,7 +38,7 @@ def main() -> None:
     for name in args.names:
         requirement, parts = oracle_c.CORPORA[name]
         root = oracle_c.fetch(args.corpus, requirement)
-        for path, shown in oracle_c.corpus_files(root, parts):
+        for path, shown in oracle_c.corpus_files(root, parts)[:: args.every]:
             source = Path(path).read_text(encoding="utf-8", errors="replace")
             files.append((shown, source, oracle_c.SUFFIXES[Path(path).suffix]))
     best = float("inf")

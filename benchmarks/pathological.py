@@ -101,6 +101,11 @@ CASES: list[tuple[str, str, Make, int]] = [
     ),
     ("cpp classes in methods", "cpp", lambda n: "class A { void f() {" * n + "}" * n + ";", 4_000),
     ("cpp deep templates", "cpp", lambda n: _c("A<" * n + "int" + ">" * n + "::g();"), 3_000),
+    # the token reading (damage everywhere): a head across thousands of #if groups, a K&R
+    # head with thousands of declarations, thousands of macro calls without `;`
+    ("c #if around one head", "c", lambda n: "@\n" + "#if A\nX(a)\n#endif\n" * n + "{}\n", 20_000),
+    ("c K&R declarations", "c", lambda n: "@\nint f(a)\n" + "int a;\n" * n + "{ }\n", 20_000),
+    ("c macro calls no ;", "c", lambda n: "@\n" + "DECLARE(x)\n" * n + "int f(void) { }\n", 40_000),
     (
         "c one-line initializer",
         "c",

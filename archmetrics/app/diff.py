@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
+from typing import NamedTuple
 
 from archmetrics.app.collect import parse_all, select
 from archmetrics.app.coupling import configuration_files
@@ -25,6 +26,7 @@ from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.unchanged import Unchanged
+from archmetrics.complexity import Reading
 from archmetrics.complexity.thresholds import check_units
 from archmetrics.coupling import group_elements
 from archmetrics.facts import FileFacts, ParseWarning
@@ -33,6 +35,26 @@ from archmetrics.reports.model import DiffReport
 from archmetrics.sources import Snapshot
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.checkout import Checkout, open_checkout
+
+
+class Measured(NamedTuple):
+    """A diff's measure: the change, the parse warnings of both sides, and how much of the
+    two sides' files was read in full."""
+
+    change: ChangeReport
+    warnings: tuple[ParseWarning, ...]
+    reading: Reading
+
+
+def reading_of(*sides: Sequence[FileRow], rules: LocationRules | None = None) -> Reading:
+    """How much of the files of each side was read in full (files an exclude glob of
+    ``rules`` leaves out are not counted); a file both sides hold alike counts once."""
+    seen: dict[tuple[str, str], FileRow] = {}
+    for side in sides:
+        for row in side:
+            if rules is None or not rules.is_excluded(row.path):
+                seen.setdefault((row.path, row.blob), row)
+    return Reading.of((bool(row.warnings), row.functions, row.estimated) for row in seen.values())
 
 
 def parse_warnings(
@@ -72,8 +94,9 @@ def measure_change(
     checkout: Checkout | None = None,
     options: DiffOptions | None = None,
     sides: list[Side] | None = None,
-) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
-    """The change report between the two snapshots, and the parse warnings of both sides.
+) -> Measured:
+    """The change report between the two snapshots, the parse warnings of both sides, and
+    how much of them was read in full.
     ``checkout``: the repository, opened once by the caller (else opened here); ``options``:
     the request's options, merged once by the caller (else here); ``sides``, if given,
     receives the base's and the head's side. Every step is named on ``progress``: reading
@@ -98,7 +121,7 @@ def measure_snapshots(
     progress: Progress | None = None,
     cache: FactsCache | None = None,
     sides: list[Side] | None = None,
-) -> tuple[ChangeReport, tuple[ParseWarning, ...]]:
+) -> Measured:
     """:func:`measure_change` of two snapshots already opened (``renames``: old path -> new
     path, or how to ask for them when the head's state was not patched from the base's),
     under ``options``. Each side's state comes from app/tree.py: kept, patched or built."""
@@ -122,7 +145,11 @@ def measure_snapshots(
     change = compare_sides(pre, post, moved, options, progress, cache)
     progress.stop()
     change = for_gates(change, pre, post, options.rules, bool(options.unit_gates))
-    return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
+    return Measured(
+        change,
+        parse_warnings(pre.state.rows, post.state.rows, rules=options.rules),
+        reading_of(pre.state.rows, post.state.rows, rules=options.rules),
+    )
 
 
 def compare_sides(
@@ -219,7 +246,7 @@ def run_diff(
     options = options or diff_options(request, checkout.root, checkout)  # a bad gate fails
     # before any work
     sides: list[Side] = []
-    change, warnings = measure_change(request, progress, cache, checkout, options, sides)
+    change, warnings, reading = measure_change(request, progress, cache, checkout, options, sides)
     gates = options.gates
     label = request.base_label or request.base
     texts = (*(g.text for g in gates), *(t.text for t in options.unit_gates))
@@ -235,7 +262,7 @@ def run_diff(
     return replace(
         report, gates=texts, failures=failures, offenders=checked.failures,
         suppressed=checked.suppressed, baselined=checked.baselined, origins=origins,
-        commits=commits,
+        commits=commits, reading=reading,
     )  # fmt: skip
 
 

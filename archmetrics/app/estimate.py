@@ -247,8 +247,8 @@ def _with_actual(
     cache: FactsCache | None,
 ) -> EstimateReport:
     """The report with the measured change and each architecture's errors against it."""
-    change, warnings = measure_change(request, progress, cache, checkout, options)
-    actual = DiffReport(request.base, request.head, change, warnings)
+    change, warnings, reading = measure_change(request, progress, cache, checkout, options)
+    actual = DiffReport(request.base, request.head, change, warnings, reading=reading)
     accuracy = tuple(
         (a.name, compare_change(a.series.stages[0].report.change, change))
         for a in report.architectures

@@ -78,8 +78,9 @@ def sketched(
         else:
             spec = None
         pair = (before, after)
-        results.append(
-            measure_snapshots(context.options, pair, renames, context.progress, context.cache)
+        change, warnings, _ = measure_snapshots(
+            context.options, pair, renames, context.progress, context.cache
         )
+        results.append((change, warnings))
         before = after
     return results

@@ -18,7 +18,8 @@ from archmetrics.facts import FileFacts, ParseWarning
 
 class FileRow(NamedTuple):
     """One file of a tree: where it is, its content (``blob``, ``language``), λ, SLOC, v_g,
-    whether a parser read it, whether it says it is generated, and its parse warnings. A
+    whether a parser read it, whether it says it is generated, its parse warnings, and how
+    many functions it has and how many of them are estimated (``Function.estimated``). A
     named tuple: a state read from the cache makes one per file of the tree."""
 
     path: str
@@ -30,12 +31,15 @@ class FileRow(NamedTuple):
     parsed: bool = True
     generated: bool = False
     warnings: tuple[ParseWarning, ...] = ()
+    functions: int = 0
+    estimated: int = 0
 
     @classmethod
     def of(cls, facts: FileFacts, blob: str) -> FileRow:
         return cls(
             facts.path, facts.language, blob, facts.loc, facts.sloc, facts.vg,
-            facts.parsed, facts.generated, facts.warnings,
+            facts.parsed, facts.generated, facts.warnings, len(facts.functions),
+            sum(f.estimated for f in facts.functions),
         )  # fmt: skip
 
 

@@ -3,9 +3,10 @@
 from archmetrics.complexity.summary import (
     FileMetrics,
     FunctionMetrics,
+    Reading,
     Totals,
     file_metrics,
     totals,
 )
 
-__all__ = ["FileMetrics", "FunctionMetrics", "Totals", "file_metrics", "totals"]
+__all__ = ["FileMetrics", "FunctionMetrics", "Reading", "Totals", "file_metrics", "totals"]

@@ -10,24 +10,19 @@ from __future__ import annotations
 import bisect
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from tree_sitter import Node, QueryCursor, Tree
 
 from archmetrics.facts import (
-    Decision,
     FileFacts,
-    Function,
     Language,
     ParseWarning,
     Severity,
-    Span,
 )
 from archmetrics.parsers import c_tables
-from archmetrics.parsers.c_family_bindings import bindings
 from archmetrics.parsers.c_family_branches import ALL, Conditionals, Group
-from archmetrics.parsers.c_family_calls import CallSites
-from archmetrics.parsers.c_family_definitions import Definition, definitions
+from archmetrics.parsers.c_family_facts import Composite, facts, standalone
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
     Grammar,
@@ -35,48 +30,32 @@ from archmetrics.parsers.c_family_grammar import (
     errors_and_missing,
     function_bodies,
     grammar,
-    missing_parents,
+    stray_directive,
     syntax_tree,
 )
-from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
+from archmetrics.parsers.c_family_macros import blank_macros, directive_comments
 from archmetrics.parsers.c_family_names import (
-    Scopes,
-    function_name,
-    function_parameters,
     in_order,
-    typedef_names,
 )
-from archmetrics.parsers.c_family_outline import Counted, classes, includes, warnings
 from archmetrics.parsers.c_family_regions import Choice, Layout, choose, damaged, joined
-from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
-from archmetrics.parsers.c_family_text import blank_comments, sloc
+from archmetrics.parsers.c_family_text import blank_spans
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, not_measured
 
 __all__ = ["Grammar", "grammar", "hide_extern_c_guards", "parse"]
 
 
-@dataclass(slots=True)
-class FunctionSlot:
-    """A function being measured: where it is and what has been found inside it."""
-
-    name: str
-    qualified: str
-    span: Span
-    start: int
-    end: int
-    body_start: int
-    body_end: int
-    decisions: list[Decision] = field(default_factory=list)
-    statements: int = 0
-    parameters: tuple[str, ...] = ()
-
-
 def parse(
-    path: str, source: str, language: Language, limits: ParseLimits = DEFAULT_LIMITS
+    path: str,
+    source: str,
+    language: Language,
+    limits: ParseLimits = DEFAULT_LIMITS,
+    second_reading: bool = True,
 ) -> FileFacts:
-    """Facts for one C or C++ file. Never raises: what cannot be read becomes a warning."""
+    """Facts for one C or C++ file. Never raises: what cannot be read becomes a warning.
+    ``second_reading=False``: the syntax tree's facts alone, no token reading where it
+    cannot be trusted and no warnings (benchmarks/oracle_c.py measures warnings by it)."""
     try:
-        return _parse(path, source, language, limits)
+        return _parse(path, source, language, limits, second_reading)
     except Exception as error:  # a bug here must not stop a whole repository's measurement
         message = f"C/C++ parser failed ({type(error).__name__}: {error}); file not measured"
         return FileFacts(
@@ -143,7 +122,7 @@ class Reading:
             )
         root = tree.root_node
         if damage_only and root.has_error:  # found without a query: any depth is safe
-            found = errors_and_missing(root)
+            found = errors_and_missing(root, data)
             return cls(data, tree, found, _damage(found), complete=False)
         problem = _too_deep(root, limits)
         if problem is not None:
@@ -169,7 +148,7 @@ class Reading:
 
     def standalone(self) -> list[Node]:
         """The type specifiers that are a statement of their own (``struct S { ... };``)."""
-        return _standalone(self.root, self.found.get("specifier", []))
+        return standalone(self.root, self.found.get("specifier", []))
 
     def bodies(self) -> list[tuple[int, int]]:
         """Byte ranges of the function bodies this parse found."""
@@ -208,6 +187,13 @@ def _captures(
                     if (name, node.id) not in seen:
                         seen.add((name, node.id))
                         kept.append(node)
+    strays = [
+        node
+        for node in found.get("stmt", [])
+        if node.type == "preproc_call" and stray_directive(node, data)
+    ]
+    if strays:  # an #else of a group closed early: damage (c_family_grammar.py)
+        found.setdefault("error", []).extend(strays)
     named = found.get("catch")
     if named:
         catches = [node for node in named if data[node.start_byte : node.end_byte] == b"catch"]
@@ -243,23 +229,9 @@ def _damage(found: dict[str, list[Node]]) -> tuple[int, int]:
 BRANCH_SPELLINGS = 3
 
 
-@dataclass(slots=True)
-class Composite:
-    """What the facts are read from: the captures of the file as written, and inside each
-    region it could not read, those of the spelling that read the region best
-    (c_family_regions.py), with the decisions of the directives a spelling blanked."""
-
-    root: Node
-    found: dict[str, list[Node]]
-    standalone: list[Node]
-    directive_decisions: list[tuple[int, str, int]] = field(default_factory=list)
-
-    @classmethod
-    def of(cls, reading: Reading) -> Composite:
-        return cls(reading.root, reading.found, reading.standalone())
-
-
-def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> FileFacts:
+def _parse(
+    path: str, source: str, language: Language, limits: ParseLimits, second_reading: bool
+) -> FileFacts:
     if "\r" in source:  # a compiler reads \r\n and a lone \r as newlines, and so do we: the
         # macro rules read lines as ending in \n (a CRLF checkout of a file read otherwise
         # than its LF blob; docs/metrics.md, "Line endings")
@@ -267,6 +239,9 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
     built = grammar(language)
     data = hide_extern_c_guards(source.encode("utf-8", "surrogatepass"))
     first = blank_macros(data, names=limits.c_macros, first=True)
+    hidden = directive_comments(data)
+    if hidden:  # comments that end a continued #define for tree-sitter
+        first = blank_spans(first, hidden)
     reading = Reading.of(built, first, limits, damage_only=True)
     if isinstance(reading, str):
         return not_measured(path, str(language), 1, reading)
@@ -275,8 +250,9 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
         if isinstance(reading, str):
             return not_measured(path, str(language), 1, reading)
     composite = _branches(built, reading, limits) if reading.root.has_error else None
-    reading_used = composite or Composite.of(reading)
-    return _facts(path, language, built, reading_used, data, limits.c_macros)
+    reading_used = composite or Composite(reading.root, reading.found, reading.standalone())
+    reading_used.hidden_comments = hidden
+    return facts(path, language, built, reading_used, data, limits.c_macros, second_reading)
 
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading | str:
@@ -387,7 +363,7 @@ def _branches(built: Grammar, reading: Reading, limits: ParseLimits) -> Composit
             break
     if not choices:
         return None
-    return _merge(reading, readings, choices, found_in)
+    return _merge(reading, readings, choices, found_in, [layout.set_aside for layout in layouts])
 
 
 def _covered(base: Layout, choices: list[Choice]) -> bool:
@@ -489,8 +465,11 @@ def _merge(
     readings: list[Reading],
     choices: list[Choice],
     directives: list[list[tuple[int, str, int]]],
+    set_aside: list[list[tuple[int, int]]],
 ) -> Composite:
-    """``base``'s captures outside the chosen regions, the chosen readings' inside."""
+    """``base``'s captures outside the chosen regions, the chosen readings' inside, and the
+    #if branches a chosen reading set aside there (they are read from tokens: a function
+    there is reported, estimated, under a warning; c_family_trust.py)."""
     starts = [choice.start for choice in choices]
 
     def outside(node: Node) -> bool:
@@ -500,8 +479,14 @@ def _merge(
     found = {name: [n for n in nodes if outside(n)] for name, nodes in base.found.items()}
     standalone = [node for node in base.standalone() if outside(node)]
     decisions: list[tuple[int, str, int]] = []
+    aside: list[tuple[int, int]] = []
     for choice in choices:
         chosen = readings[choice.reader]
+        aside.extend(
+            (max(s, choice.start), min(e, choice.end))
+            for s, e in set_aside[choice.reader]
+            if s < choice.end and choice.start < e
+        )
 
         def inside(node: Node, choice: Choice = choice) -> bool:
             return choice.start <= node.start_byte and node.end_byte <= choice.end
@@ -511,213 +496,4 @@ def _merge(
         standalone.extend(filter(inside, chosen.standalone()))
         blanked = directives[choice.reader]
         decisions.extend(d for d in blanked if choice.start <= d[0] < choice.end)
-    return Composite(base.root, found, standalone, decisions)
-
-
-def _facts(
-    path: str,
-    language: Language,
-    built: Grammar,
-    reading: Composite,
-    data: bytes,
-    macros: MacroNames,
-) -> FileFacts:
-    """The facts of ``reading``'s captures, with every text taken from ``data`` as written."""
-    root, found = reading.root, reading.found
-    typedefs = typedef_names(found.get("stmt", []), data)
-    scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
-    missing = found.get("missing", [])
-    parents = missing_parents(root) if missing else {}
-    made, explained = definitions(
-        in_order(found.get("stmt", [])), missing, data, macros.function, parents
-    )
-    slots = _functions(made, data, scopes)
-    owner = _Owners(slots)
-    skip = {node.id for node in found.get("skip", [])}
-    guard = include_guard(root, data)
-    if guard is not None:
-        skip.add(guard)
-    nodes = in_order(
-        node for node in found.get("stmt", []) + reading.standalone if node.id not in skip
-    )
-    comments = sorted((n.start_byte, n.end_byte) for n in found.get("comment", []))
-    clean = blank_comments(data, comments)
-    facts_statements = statements(
-        nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
-    )
-    _decisions(found, owner, reading.directive_decisions)
-    call_sites = CallSites(found.get("call", []), data).sites(owner.names)
-    bound = bindings(found.get("bind", []), clean, owner.names)
-    return FileFacts(
-        path=path,
-        language=str(language),
-        statements=tuple(facts_statements),
-        functions=tuple(
-            Function(s.name, s.qualified, s.span, tuple(s.decisions), s.statements, s.parameters)
-            for s in slots
-        ),
-        classes=classes(found.get("class", []), scopes),
-        dependencies=includes(nodes, data),
-        call_sites=call_sites,
-        bindings=bound,
-        sloc=sloc(clean),
-        warnings=warnings(
-            path,
-            {**found, "expected": found.get("expected", []) + explained},
-            data,
-            clean,
-            Counted(
-                sorted(d.line for s in slots for d in s.decisions),
-                sorted(s.span.start for s in facts_statements),
-                sorted(c.span.start for c in call_sites),
-            ),
-        ),
-    )
-
-
-def _standalone(root: Node, specifiers: list[Node]) -> list[Node]:
-    """Type specifiers that are a statement of their own: those whose parent is a container
-    (a file, a block, a class or namespace body), not a declaration.
-
-    The parents are found by one cursor moving through the tree from one specifier to the
-    next (up, forward, down), not by ``node.parent``: tree-sitter finds a parent by
-    descending from the root again, which costs n² steps for n nested specifiers."""
-    containers = c_tables.SPECIFIER_CONTAINERS
-    standalone: list[Node] = []
-    cursor = root.walk()
-    above: list[str] = []  # the types of the nodes above the cursor's, innermost last
-    for node in in_order(specifiers):
-        start, end = node.start_byte, node.end_byte
-        at: Node | None = cursor.node
-        while at is not None and not (at.start_byte <= start and end <= at.end_byte):
-            if at.end_byte <= start and cursor.goto_next_sibling():
-                at = cursor.node  # forward among siblings: a wide node is crossed once
-            elif cursor.goto_parent():
-                at = cursor.node
-                above.pop()
-            else:
-                break
-        while at is not None and at.id != node.id:
-            kind = at.type
-            if cursor.goto_first_child_for_byte(start) is None:
-                break
-            above.append(kind)
-            at = cursor.node
-            while at is not None and at.end_byte < end and cursor.goto_next_sibling():
-                at = cursor.node  # a child that ends too soon (empty, or a missing token)
-        if at is not None and at.id == node.id and above and above[-1] in containers:
-            standalone.append(node)
-    return standalone
-
-
-class _Owners:
-    """Which measured function encloses a byte offset (functions do not overlap)."""
-
-    def __init__(self, slots: list[FunctionSlot]) -> None:
-        self.slots = slots
-        self._starts = [slot.start for slot in slots]
-
-    def at(self, offset: int) -> FunctionSlot | None:
-        """The function whose definition holds byte ``offset``, if any."""
-        index = bisect.bisect_right(self._starts, offset) - 1
-        if index >= 0 and offset < self.slots[index].end:
-            return self.slots[index]
-        return None
-
-    def claim(self, offsets: list[int]) -> list[str | None]:
-        """The enclosing function's name at each offset; counts one more statement in each."""
-        names: list[str | None] = []
-        for slot in self._slots_at(offsets):
-            if slot is None:
-                names.append(None)
-            else:
-                slot.statements += 1
-                names.append(slot.qualified)
-        return names
-
-    def names(self, offsets: list[int]) -> list[str | None]:
-        """The enclosing function's name at each offset."""
-        return [None if slot is None else slot.qualified for slot in self._slots_at(offsets)]
-
-    def _slots_at(self, offsets: list[int]) -> list[FunctionSlot | None]:
-        """The function holding each offset (one bisection each: the file's statements are
-        claimed all at once)."""
-        slots, starts = self.slots, self._starts
-        if not slots:
-            return [None] * len(offsets)
-        found: list[FunctionSlot | None] = []
-        for offset in offsets:
-            index = bisect.bisect_right(starts, offset) - 1
-            found.append(slots[index] if index >= 0 and offset < slots[index].end else None)
-        return found
-
-
-def _functions(definitions: list[Definition], data: bytes, scopes: Scopes) -> list[FunctionSlot]:
-    """Function definitions with a body that are not inside another function (as lizard)."""
-    slots: list[FunctionSlot] = []
-    last_end = -1
-    prefixes = scopes.prefixes([definition.node for definition in definitions])
-    for definition in definitions:
-        node, body = definition.node, definition.body
-        if node.start_byte < last_end:
-            continue
-        prefix = prefixes[node.id]
-        parameters: tuple[str, ...] = ()
-        if definition.macro is None:
-            name, qualified = function_name(node, data, prefix)
-            parameters = function_parameters(node, data)
-        else:
-            name, qualified = definition.macro, f"{prefix}::{definition.macro}".lstrip(":")
-        slots.append(
-            FunctionSlot(
-                name,
-                qualified,
-                definition.span,
-                definition.start,
-                definition.end,
-                body.start_byte,
-                body.end_byte,
-                parameters=parameters,
-            )
-        )
-        last_end = definition.end
-    return slots
-
-
-def _decisions(
-    found: dict[str, list[Node]], owner: _Owners, directives_read: list[tuple[int, str, int]]
-) -> None:
-    """Add each decision token inside a function body to that function, and each decision
-    of ``directives_read`` ((offset, kind, line) of directives a spelling blanked)."""
-    not_decisions = {node.id for node in found.get("nodecision", [])}
-    directives = sorted((node.start_byte, node.end_byte) for node in found.get("directive", []))
-    directive_starts = [start for start, _ in directives]
-    for node in in_order(found.get("decision", []) + found.get("catch", [])):
-        offset = node.start_byte
-        slot = owner.at(offset)
-        if slot is None or node.id in not_decisions:
-            continue
-        index = bisect.bisect_right(directive_starts, offset) - 1
-        if index >= 0 and offset < directives[index][1]:
-            continue  # inside `#if A && B`
-        if slot.body_start <= offset < slot.body_end:
-            kind = c_tables.DECISIONS.get(node.type, "catch")  # an identifier `catch`
-            slot.decisions.append(Decision(kind, node.start_point.row + 1))
-    for offset, kind, line in directives_read:
-        slot = owner.at(offset)
-        if slot is not None and slot.body_start <= offset < slot.body_end:
-            slot.decisions.append(Decision(kind, line))
-    for slot in owner.slots:
-        slot.decisions.sort(key=lambda decision: decision.line)
-
-
-def _templates(found: dict[str, list[Node]]) -> dict[int, tuple[int, int]]:
-    """Start byte of each templated declaration -> (byte, row) where its `template` begins."""
-    starts: dict[int, tuple[int, int]] = {}
-    for node in in_order(found.get("template", [])):
-        inner = node.named_child(node.named_child_count - 1) if node.named_child_count else None
-        if inner is None:
-            continue
-        begin = starts.get(node.start_byte, (node.start_byte, node.start_point.row))
-        starts[inner.start_byte] = begin
-    return starts
+    return Composite(base.root, found, standalone, decisions, set_aside=aside)

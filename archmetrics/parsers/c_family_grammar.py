@@ -66,6 +66,9 @@ def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule])
         "(MISSING) @missing",
         "(template_instantiation (MISSING) @expected)",  # `template class Box<int>;`
         f"({c_tables.TEMPLATE}) @template",
+        *c_tables.STRAY_BLOCKS,
+        c_tables.MISREAD_HEAD,
+        c_tables.CAST_AND,
         "[" + " ".join(f"({kind})" for kind in c_tables.BODIES) + "] @body",
     ]
 
@@ -172,11 +175,23 @@ def differing(before: bytes, after: bytes) -> Iterator[tuple[int, int]]:
             yield offset + found.start(), offset + found.end()
 
 
-def errors_and_missing(root: Node) -> dict[str, list[Node]]:
-    """A tree's ``ERROR`` nodes and the tokens its parser invented (``MISSING``), as the
-    query's ``error`` and ``missing`` captures would give them, in no order. Found without
-    a query: only children that hold an error are entered (``has_error``), so a clean
-    stretch of the file costs nothing, where a query walks every node."""
+_STRAY_DIRECTIVE = re.compile(rb"\#[ \t]*+(?:elif|else|endif|elifdef|elifndef)\b")
+
+
+def stray_directive(node: Node, data: bytes) -> bool:
+    """Whether ``node``, a directive tree-sitter read as one of its own (``preproc_call``),
+    is an ``#elif``, ``#else`` or ``#endif``: the rest of a conditional group whose ``#if``
+    the parser closed early (an ``#if`` branch that closes a brace, ``} else {``), read as
+    no group at all. It is damage, like an ``ERROR``."""
+    return _STRAY_DIRECTIVE.match(data, node.start_byte, node.end_byte) is not None
+
+
+def errors_and_missing(root: Node, data: bytes) -> dict[str, list[Node]]:
+    """A tree's ``ERROR`` nodes (and stray ``#else`` lines: ``stray_directive``) and the
+    tokens its parser invented (``MISSING``), as the query's ``error`` and ``missing``
+    captures would give them, in no order. Found without a query: only children that hold
+    an error are entered (``has_error``), so a clean stretch of the file costs nothing,
+    where a query walks every node."""
     errors: list[Node] = []
     missing: list[Node] = []
     stack = [root] if root.has_error else []
@@ -188,6 +203,8 @@ def errors_and_missing(root: Node) -> dict[str, list[Node]]:
                 missing.append(child)
             elif child.is_error:
                 errors.append(child)  # (an ERROR leaf inside an ERROR may lack has_error)
+            elif child.type == "preproc_call" and stray_directive(child, data):
+                errors.append(child)
             if child.has_error:
                 stack.append(child)
     return {"error": errors, "missing": missing}

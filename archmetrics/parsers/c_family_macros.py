@@ -265,6 +265,10 @@ class _Ranges:
         self._spans = sorted(spans)
         self._starts = [start for start, _ in self._spans]
 
+    @property
+    def spans(self) -> list[tuple[int, int]]:
+        return self._spans
+
     def __contains__(self, offset: object) -> bool:
         assert isinstance(offset, int)
         index = bisect.bisect_right(self._starts, offset) - 1
@@ -286,6 +290,24 @@ def directive_spans(data: bytes) -> _Ranges:
     first = at_start.pattern.match(data)
     spans = [first.span()] if first else []
     return _Ranges(spans + [found.span() for found in after_newline.pattern.finditer(data)])
+
+
+_BLOCK_COMMENT = re.compile(rb"/\*(?:[^*]|\*(?!/))*+\*/")
+
+
+def directive_comments(data: bytes) -> list[tuple[int, int]]:
+    r"""The block comments inside a directive continued over lines (``do { /* c */ \``):
+    tree-sitter ends the directive at such a comment and reads the rest of its body as
+    code, so they are blanked before the first parse (their lines stay, and are blanked
+    from SLOC as every comment is)."""
+    if b"\\\n" not in data or b"/*" not in data:
+        return []
+    found: list[tuple[int, int]] = []
+    ranges = directive_spans(data)
+    for start, end in ranges.spans:
+        if data.find(b"\\\n", start, end) >= 0 and data.find(b"/*", start, end) >= 0:
+            found.extend(m.span() for m in _BLOCK_COMMENT.finditer(data, start, end))
+    return found
 
 
 @functools.lru_cache(maxsize=4)

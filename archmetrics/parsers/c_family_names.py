@@ -129,6 +129,11 @@ class Scopes:
         return found
 
 
+    def prefix_at(self, offset: int) -> str:
+        """The qualified name of the named scopes around byte ``offset`` ("" if none)."""
+        return _tail("::".join(name for start, end, name in self._named if start < offset < end))
+
+
 def _tail(qualified: str) -> str:
     if len(qualified) <= shown.LIMIT:
         return qualified
@@ -163,10 +168,28 @@ def _name_text(node: Node, data: bytes) -> str:
 _PARAMETER_WRAPPERS = _DECLARATOR_WRAPPERS | {"array_declarator", "function_declarator"}
 
 
-def function_parameters(function: Node, data: bytes) -> tuple[str, ...]:
-    """The parameter names of a function definition, in order: `(const char *port, int
-    n)` gives `port`, `n`; a function pointer `void (*cb)(int)` gives `cb`; `(void)`, `...`
-    and unnamed parameters give nothing."""
+def _wrapped(declarator: Node, data: bytes) -> Node | None:
+    """The function declarator a wrapper macro's argument holds, when ``declarator`` (a
+    function declarator) is such a macro's call: `HEAP_EXPORT(void heap_init(struct heap*
+    h))`, `UV_UNUSED(static void f(uv_loop_t* loop))` (a name in capitals, one parameter
+    that declares a function). The function is that one, as the code names it."""
+    name = declarator.child_by_field_name("declarator")
+    listed = declarator.child_by_field_name("parameters")
+    if name is None or listed is None or listed.named_child_count != 1:
+        return None
+    word = text(name, data)
+    if name.type != "identifier" or word.upper() != word or word.lower() == word:
+        return None  # (not in capitals, or no letter at all)
+    parameter = listed.named_child(0)
+    inner = parameter.child_by_field_name("declarator") if parameter is not None else None
+    while inner is not None and inner.type in _DECLARATOR_WRAPPERS:
+        inner = inner.child_by_field_name("declarator")
+    return inner if inner is not None and inner.type == "function_declarator" else None
+
+
+def _function_declarator(function: Node, data: bytes) -> Node | None:
+    """A function definition's function declarator (a wrapper macro's argument's, if it is
+    one), or None."""
     node = function.child_by_field_name("declarator")
     while node is not None and node.type in _DECLARATOR_WRAPPERS:
         inner = node.child_by_field_name("declarator")
@@ -174,6 +197,16 @@ def function_parameters(function: Node, data: bytes) -> tuple[str, ...]:
             inner = node.named_child(node.named_child_count - 1)
         node = inner
     if node is None or node.type != "function_declarator":
+        return None
+    return _wrapped(node, data) or node
+
+
+def function_parameters(function: Node, data: bytes) -> tuple[str, ...]:
+    """The parameter names of a function definition, in order: `(const char *port, int
+    n)` gives `port`, `n`; a function pointer `void (*cb)(int)` gives `cb`; `(void)`, `...`
+    and unnamed parameters give nothing."""
+    node = _function_declarator(function, data)
+    if node is None:
         return ()
     listed = node.child_by_field_name("parameters")
     names: list[str] = []
@@ -202,7 +235,7 @@ def function_name(function: Node, data: bytes, prefix: str) -> tuple[str, str]:
             inner = node.named_child(node.named_child_count - 1)
         node = inner
     if node is not None and node.type == "function_declarator":
-        node = node.child_by_field_name("declarator")
+        node = (_wrapped(node, data) or node).child_by_field_name("declarator")
     elif declarator is not None and declarator.type == "parenthesized_declarator":
         node = function.child_by_field_name("type")  # `NAME(args) {`: a macro-made function
     own = _name_text(node, data) if node is not None else "(anonymous)"

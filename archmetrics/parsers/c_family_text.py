@@ -175,6 +175,14 @@ def blank(out: bytearray, start: int, end: int) -> None:
     out[start:end] = bytes(out[start:end]).translate(_BLANK)
 
 
+def blank_spans(data: bytes, spans: list[tuple[int, int]]) -> bytes:
+    """``data`` with ``spans`` overwritten by spaces, line ends kept."""
+    out = bytearray(data)
+    for start, end in spans:
+        blank(out, start, end)
+    return bytes(out)
+
+
 def whole_lines(data: bytes, start: int, end: int) -> tuple[int, int]:
     """``[start, end)`` grown to whole lines (the last one's newline excluded)."""
     after = data.find(b"\n", end)

@@ -144,6 +144,36 @@ DIRECTIVE_CONDITIONS = (
     "(preproc_elif condition: (_) @directive)",
 )
 
+#: A block where no statement may stand (between declarations): tree-sitter read the head
+#: before it as something else (a K&R definition with a pointer return type, a macro).
+#: (Patterns name only parents that do not nest deeply: c_family_grammar.py.)
+STRAY_BLOCKS = (
+    "(translation_unit (compound_statement) @stray)",
+    "(declaration_list (compound_statement) @stray)",
+    # in an #if branch: only those outside every function body are stray (c_family_facts)
+    "[(preproc_if (compound_statement) @stray) (preproc_ifdef (compound_statement) @stray)"
+    " (preproc_else (compound_statement) @stray) (preproc_elif (compound_statement) @stray)]",
+    # `static void f(struct s *p, t *w) {};`: tree-sitter-cpp reads a declaration with a
+    # brace initializer, which no function declarator can have: the body of a definition
+    "(declaration declarator: (init_declarator declarator: (function_declarator)"
+    " value: (initializer_list) @braced))",
+)
+
+#: A function head with calls or words after its parameter list (``GENERATE_TEST(a)`` /
+#: ``GENERATE_TEST(b)`` / ``int main(void) {``: macro calls without their `;` read as one
+#: head, named after the first; ``char *f(a) int a; {`` read likewise).
+MISREAD_HEAD = (
+    "(function_definition declarator: (function_declarator parameters: (parameter_list) ."
+    " [(identifier) (call_expression)]) body: (_) @misread)"
+)
+
+#: `(std::isnan)(a) && b > 0`: tree-sitter takes `(a)` for a cast and `&& b` for two
+#: address-of operators; the outer one is captured and counted where it is spelled `&&`.
+CAST_AND = (
+    "(cast_expression type: (type_descriptor type: (type_identifier) !declarator)"
+    " value: (pointer_expression argument: (pointer_expression)) @castand)"
+)
+
 #: Bodies whose contents are statements of their own: cut out of a statement's text.
 BODIES = ("compound_statement", "field_declaration_list", "declaration_list")
 

@@ -19,7 +19,7 @@ from archmetrics.changeset.gates import (
     parse_gate,
 )
 from archmetrics.changeset.model import ChangeReport, Summary
-from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity import FileMetrics, Reading, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
@@ -63,6 +63,7 @@ def _file(metrics: FileMetrics) -> dict[str, Any]:
                 "end_line": f.end_line,
                 "loc": f.loc,
                 "vg": f.vg,
+                "estimated": f.estimated,
             }
             for f in metrics.functions
         ],
@@ -79,6 +80,8 @@ def totals_dict(totals: Totals) -> dict[str, Any]:
         "vg": totals.vg,
         "warnings": totals.warnings,
         "unparsed": totals.unparsed,
+        "files_warned": totals.files_warned,
+        "functions_estimated": totals.functions_estimated,
     }
 
 
@@ -197,6 +200,16 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
             if isinstance(failure, UnmeasuredFailure)
             for path, why in failure.files
         ],
+        **({} if report.reading is None else {"reading": reading_dict(report.reading)}),
+    }
+
+
+def reading_dict(reading: Reading) -> dict[str, Any]:
+    return {
+        "files": reading.files,
+        "files_warned": reading.files_warned,
+        "functions": reading.functions,
+        "functions_estimated": reading.functions_estimated,
     }
 
 

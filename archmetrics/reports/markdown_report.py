@@ -80,7 +80,10 @@ def render_scan(report: ScanReport, grouping: str) -> str:
     ]
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     if warnings:
-        parts.append("\n**Warnings**\n\n" + "".join(f"{w}\n" for w in _bullets(warnings)))
+        parts.append(
+            f"\n**Warnings**: {t.reading().line()}\n\n"
+            + "".join(f"{w}\n" for w in _bullets(warnings))
+        )
     if report.excluded:
         parts.append("".join(f"{line}\n" for line in _excluded(report.excluded)))
     parts += [f"*Note: {table_cell(str(note))}*\n" for note in report.notes]
@@ -151,6 +154,8 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
         bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += _bullets(shown_warnings(report.warnings), "warning ")
     bullets += _bullets((diff_rows.unmatched_glob(g) for g in report.change.unmatched), "warning: ")
+    if report.reading is not None and report.warnings:
+        bullets.append(f"- {report.reading.line()}")
     tail = ["\n".join(bullets) + "\n"] if bullets else []
     changed = report.change.changed()
     if changed:

@@ -8,7 +8,7 @@ from archmetrics.changeset.accuracy import ChangeAccuracy
 from archmetrics.changeset.gates import GateFailure, GateOrigin
 from archmetrics.changeset.history import CommitStep
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
-from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity import FileMetrics, Reading, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.coupling import CouplingReport
 from archmetrics.facts import FileFacts, ParseWarning
@@ -89,6 +89,7 @@ class DiffReport:
     baselined: tuple[ThresholdFailure, ...] = ()  # would fail: the baseline knows them
     origins: tuple[GateOrigin, ...] = ()  # where the configured gates are written
     commits: tuple[str | None, str | None] = (None, None)  # base's and head's commit ids
+    reading: Reading | None = None  # how much of both sides was read in full
 
     @property
     def failed(self) -> tuple[GateFailure | ThresholdFailure, ...]:

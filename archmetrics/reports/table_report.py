@@ -139,7 +139,8 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     else:
         table = _file_table(report)
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
-    extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
+    reading = report.totals.reading().line()
+    extra = ["", f"warnings ({reading}):", *("  " + w for w in warnings)] if warnings else []
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
     extra += [f"note: {note}" for note in report.notes]
     legend = SCAN_LEGEND + (" " + ELEMENT_LEGEND if grouping == "element" else "")
@@ -194,6 +195,8 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
     lines += [f"warning: {diff_rows.unmatched_glob(g)}" for g in report.change.unmatched]
     lines += diff_rows.unparsed_line(report)
+    if report.reading is not None and report.warnings:
+        lines.append(report.reading.line())
     lines += [str(f) for f in report.failures]
     lines += gate_lines(report)
     lines.append(f"verdict: {diff_rows.verdict(report)}")

@@ -46,7 +46,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 9
+FORMAT = 10
 BODY_LINES = 3  # call sites, statements, bindings
 
 _new = tuple.__new__
@@ -94,6 +94,7 @@ def encode(facts: FileFacts) -> bytes:
                 [[d.kind, d.line] for d in f.decisions],
                 list(f.parameters),
                 list(f.suppressed),
+                f.estimated,
             ]
             for f in facts.functions
         ],
@@ -318,9 +319,10 @@ def _decode(
                         st,
                         tuple([intern(p) for p in ps]),
                         tuple(sp),
+                        es is True,
                     ),
                 )
-                for n, q, a, b, st, ds, ps, sp in functions
+                for n, q, a, b, st, ds, ps, sp, es in functions
             ]
         ),
         classes=tuple([Class(n, q, spans[a, b], k) for n, q, a, b, k in classes]),

@@ -51,7 +51,7 @@ from archmetrics.sources.statecolumns import (
     texts as _texts,
 )
 
-FORMAT = 3
+FORMAT = 4
 _PARSED, _GENERATED = 1, 2
 _SEVERITIES = tuple(s.value for s in Severity)
 _SEVERITY_MEMBERS = tuple(Severity)
@@ -99,6 +99,7 @@ def encode(state: TreeState) -> bytes:
         "blobs": [r.blob for r in rows],
         "languages": languages,
         "numbers": numbers,
+        "functions": [n for row in rows for n in (row.functions, row.estimated)],
         "warnings": [
             [i, w.line, w.message, _SEVERITIES.index(w.severity.value)]
             for i, row in enumerate(rows)
@@ -220,6 +221,10 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
         warnings.setdefault(i, []).append(
             ParseWarning(files[i], line, message, _SEVERITY_MEMBERS[severity])
         )
+    counts = _ints(document.get("functions"), 0, 1 << 62, 2 * count)
+    pairs = zip(counts[0::2], counts[1::2], strict=True)
+    if any(estimated > functions for functions, estimated in pairs):
+        raise _bad("more functions estimated than a file has")
     flags = numbers[3::5]
     fields = zip(
         files,
@@ -231,6 +236,8 @@ def _rows(document: dict[str, Any], files: list[str], languages: list[str]) -> t
         [bool(f & _PARSED) for f in flags],
         [bool(f & _GENERATED) for f in flags],
         [tuple(warnings.get(i, ())) for i in range(count)] if warnings else [()] * count,
+        counts[0::2],
+        counts[1::2],
         strict=True,
     )
     return tuple(map(_new, repeat(FileRow), fields))  # rows checked above: made directly

@@ -338,3 +338,25 @@ def test_every_long_step_of_a_diff_and_a_scan_is_named(history: GitRepo) -> None
     steps = _Steps()
     run_scan(ScanRequest((history.root,), None, load_settings(history.root), jobs=1), steps)
     assert steps.steps == ["listing the files", "parsing 3", "stop", "coupling", "stop"]
+
+
+LOST_HEAD = "char *f(a)\nint a;\n{\n  if (a) return 0;\n  return \"x\";\n}\n"
+
+
+def test_a_diff_reports_how_much_of_both_sides_was_read_in_full(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    # v2 adds a K&R definition tree-sitter reads as a declaration and a block: the token
+    # reading reports it, estimated, under a warning; the unchanged file counts once
+    repo.commit("one", tag="v1", files={"m.c": "int g(void) { return 1; }\n"})
+    repo.commit("two", tag="v2", files={"m.c": "int g(void) { return 1; }\n", "k.c": LOST_HEAD})
+    cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
+    for _ in range(2):  # cold, then from the trees' states the cache keeps
+        report = json.loads(_diff(repo, tmp_path, *cache))
+        assert report["reading"] == {
+            "files": 2,
+            "files_warned": 1,
+            "functions": 2,
+            "functions_estimated": 1,
+        }
+        assert [w["path"] for w in report["warnings"]] == ["k.c"]

@@ -285,7 +285,11 @@ def test_header_include_guard_and_pragma_once() -> None:
 def test_unparseable_cpp_still_measures_the_rest() -> None:
     source = "int ok() { return 1; }\nQ_OBJECT_MAGIC(x) y z {\nint later() { return 2; }\n"
     facts = cpp(source)
-    assert facts.warnings and facts.parsed
+    assert facts.parsed
+    assert [w.message for w in facts.warnings] == [
+        "lines 2-3: the brackets from line 2 on never close (a statement read as a function"
+        " definition (a macro call without its ';'?))"
+    ]
     assert "ok" in complexities(facts)
 
 
