@@ -27,6 +27,7 @@ from archmetrics.parsers import c_tables
 from archmetrics.parsers.c_family_bindings import bindings
 from archmetrics.parsers.c_family_branches import ALL, Conditionals, Group
 from archmetrics.parsers.c_family_calls import CallSites
+from archmetrics.parsers.c_family_constructs import call_targets, constructions, field_types
 from archmetrics.parsers.c_family_definitions import Definition, definitions
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
@@ -38,7 +39,7 @@ from archmetrics.parsers.c_family_grammar import (
     missing_parents,
     syntax_tree,
 )
-from archmetrics.parsers.c_family_macros import MacroNames, blank_macros
+from archmetrics.parsers.c_family_macros import MacroNames, blank_macros, macro_calls
 from archmetrics.parsers.c_family_names import (
     Scopes,
     function_name,
@@ -270,13 +271,14 @@ def _parse(path: str, source: str, language: Language, limits: ParseLimits) -> F
     reading = Reading.of(built, first, limits, damage_only=True)
     if isinstance(reading, str):
         return not_measured(path, str(language), 1, reading)
-    if reading.root.has_error:
+    damaged = reading.root.has_error  # (a macro called without its `;` is damage)
+    if damaged:
         reading = _recover(built, reading, limits)
         if isinstance(reading, str):
             return not_measured(path, str(language), 1, reading)
     composite = _branches(built, reading, limits) if reading.root.has_error else None
     reading_used = composite or Composite.of(reading)
-    return _facts(path, language, built, reading_used, data, limits.c_macros)
+    return _facts(path, language, built, reading_used, data, limits.c_macros, damaged)
 
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading | str:
@@ -521,8 +523,11 @@ def _facts(
     reading: Composite,
     data: bytes,
     macros: MacroNames,
+    damaged: bool = False,
 ) -> FileFacts:
-    """The facts of ``reading``'s captures, with every text taken from ``data`` as written."""
+    """The facts of ``reading``'s captures, with every text taken from ``data`` as written.
+    ``damaged``: the first parse had errors (then macros called alone on their line, which
+    a reading may have blanked, are call sites too)."""
     root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
@@ -546,7 +551,16 @@ def _facts(
         nodes, built.rules, Bodies(found.get("body", [])), clean, _templates(found), owner.claim
     )
     _decisions(found, owner, reading.directive_decisions)
-    call_sites = CallSites(found.get("call", []), data).sites(owner.names)
+    constructs = in_order(found.get("construct", []))
+    members = field_types(found.get("field", []), data) if constructs else {}
+    targets = call_targets(
+        [*found.get("bind", []), *(n for n in constructs if n.type == "field_initializer")], data
+    )
+    constructed = [c for node in constructs for c in constructions(node, data, members, targets)]
+    called = macro_calls(data, ()) if damaged else []
+    call_sites = CallSites(found.get("call", []), data, targets).sites(
+        owner.names, constructed, called
+    )
     bound = bindings(found.get("bind", []), clean, owner.names)
     return FileFacts(
         path=path,

@@ -59,6 +59,11 @@ def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule])
         f"[{classes}] @class",
         f"({c_tables.NAMESPACE}) @namespace",
         "(call_expression) @call",
+        # constructor calls without a call expression (c_family_constructs.py)
+        "[(new_expression) (field_initializer)] @construct",
+        "(declaration declarator: (init_declarator value: [(argument_list) (initializer_list)]))"
+        " @construct",
+        "(field_declaration type: (_) declarator: (field_identifier)) @field",
         "[(init_declarator) (assignment_expression) (preproc_def)] @bind",
         "(field_declaration default_value: (_)) @bind",  # c_family_bindings
         "(comment) @comment",

@@ -79,6 +79,18 @@ def _toml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileF
     return config_toml.parse(path, source, limits)
 
 
+def _xml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    from archmetrics.parsers import config_xml
+
+    return config_xml.parse(path, source, limits)
+
+
+def _yaml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    from archmetrics.parsers import config_yaml
+
+    return config_yaml.parse(path, source, limits)
+
+
 BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     LanguageSpec(Language.PYTHON, _python, _python),
     LanguageSpec(Language.C, _c, _c),
@@ -86,6 +98,8 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     # configuration formats: no file ending maps to them; the rule packs say which files
     # are configuration (docs/metrics.md, "Configuration links")
     LanguageSpec(ConfigFormat.TOML, _toml, _toml),
+    LanguageSpec(ConfigFormat.XML, _xml, _xml),
+    LanguageSpec(ConfigFormat.YAML, _yaml, _yaml),
 )
 
 

@@ -134,7 +134,7 @@ def test_another_router_is_added_as_data(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("change", "key"),
     [
-        (("format", '"toml"', '"yaml"'), "format"),
+        (("format", '"toml"', '"json"'), "format"),
         (("table", '"routes"', '"routes[].to"'), "table"),
         (("files", '["router/*.toml"]', '["!x"]'), "files"),
         (("endpoint", "key = \"to\", ", ""), "endpoint.key"),
