@@ -30,6 +30,7 @@ from archmetrics.changeset.rows import FileRow
 from archmetrics.changeset.state import TreeState, owners, patched_state, tree_state
 from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index, patch_index
 from archmetrics.coupling.measure import link_tree
+from archmetrics.coupling.rostree import configures
 from archmetrics.facts import FileFacts
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources import Snapshot, SourceFile
@@ -219,6 +220,11 @@ def _patched(
         return None
     table = LanguageTable.default(dict(options.languages))
     configuration = configuration_files(options.packs)
+    if configuration.markers:  # which folders are ROS packages: a new or gone one, built whole
+        touched = {f.path for f in delta.changed} | set(delta.removed)
+        if any(path.rpartition("/")[2] in configuration.markers for path in touched):
+            return None
+        configuration = configuration.in_tree(row.path for row in rows_before)
     selected = [
         Selected(f, language)
         for f in delta.changed
@@ -284,6 +290,11 @@ def _patched_index(
         return row is not None and row.parsed and exclusion(row, rules) is None
 
     redone: dict[str, FileFacts] = {}
+    if origin.state.index.whole or any(
+        configures(side.facts(path)) for path in changed if path in side.by_path
+    ):  # launch, parameter or plugin files rename sites or receive them (rosgraph.py)
+        facts = [side.facts(row.path) for row in measured_files(side.state.rows, rules)]
+        return _couple(facts, side.state.rows, options, cache)
     for path in sorted(changed):
         before, after = origin.by_path.get(path), side.by_path.get(path)
         if measured(before) != measured(after) or (

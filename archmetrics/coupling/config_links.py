@@ -20,14 +20,18 @@ from archmetrics.coupling.elements import Element
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
 from archmetrics.coupling.patterns import SlowPattern, search
+from archmetrics.coupling.roslaunch import table_launched
 from archmetrics.coupling.rules import ConfigEndpoint, ConfigRule
 from archmetrics.facts import ConfigTable, FileFacts
+from archmetrics.globs import glob_matches
 
 
 def config_link_sites(facts: FileFacts, rules: Sequence[ConfigRule]) -> tuple[LinkSite, ...]:
-    """The link sites of one configuration file under ``rules`` (those of its format)."""
-    usable = [rule for rule in rules if rule.format == facts.language]
-    found: list[LinkSite] = []
+    """The link sites of one configuration file under ``rules`` (those of its format): the
+    tables the generic rules select, and what the first rule of each interpreter whose
+    ``files`` name the file reads (a launch file's nodes, roslaunch.py)."""
+    usable = [rule for rule in rules if rule.format == facts.language and not rule.interpret]
+    found: list[LinkSite] = list(_interpreted(facts, rules))
     for table in facts.tables if usable else ():
         rule = next((r for r in usable if _selects(r, table)), None)
         if rule is None:
@@ -39,6 +43,24 @@ def config_link_sites(facts: FileFacts, rules: Sequence[ConfigRule]) -> tuple[Li
                          ".".join(table.keys), endpoint, LinkStatus.UNRESOLVED, note=note)
             )  # fmt: skip
     return tuple(sorted(found, key=lambda s: (s.line, s.rule)))
+
+
+def _interpreted(facts: FileFacts, rules: Sequence[ConfigRule]) -> list[LinkSite]:
+    seen: set[str] = set()
+    found: list[LinkSite] = []
+    for rule in rules:
+        if rule.interpret is None or rule.interpret in seen or rule.format != facts.language:
+            continue
+        if not any(glob_matches(glob, facts.path) for glob in rule.files):
+            continue
+        seen.add(rule.interpret)
+        if rule.interpret == "ros-launch":
+            for entry in table_launched(facts):
+                point = Endpoint(entry.key, entry.plugin or entry.executable, "configuration")
+                callee = "composable_node" if entry.plugin else "node"
+                found.append(LinkSite(facts.path, entry.line, rule.qualified_id, rule.kind,
+                                      rule.role, callee, point, LinkStatus.UNRESOLVED))  # fmt: skip
+    return found
 
 
 def with_config_sites(

@@ -70,6 +70,8 @@ class Endpoint:
     key: str
     text: str  # as written, e.g. "tcp://*:5555" or PORT
     via: str = "argument"  # argument | constant | same-function | callee
+    # more keys the site receives on (a tf listener: topic:/tf and topic:/tf_static)
+    also: tuple[str, ...] = ()
 
 
 class LinkStatus(StrEnum):
@@ -94,6 +96,11 @@ class LinkSite:
     targets: tuple[str, ...] = ()  # elements this site links into
     function: str | None = None
     note: str = ""  # why the endpoint is unknown, when it is known why (several values ...)
+    # a graph name (ROS): the name as read, before it is resolved against its node
+    name: str = ""
+    node: str = ""  # the node the site is made in, as the code names it (/ns/talker)
+    data_type: str = ""  # the message, service or action type (geometry_msgs/msg/Twist)
+    parameter: str = ""  # the parameter whose default gave the name ("" if none)
 
 
 class EdgeKind(StrEnum):

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from archmetrics.coupling.rules import ConfigRule, EndpointSource, EndpointSpec, Rule, RuleSet
+from archmetrics.coupling.rules import (
+    ConfigRule,
+    EndpointSource,
+    EndpointSpec,
+    Place,
+    Rule,
+    RulePack,
+    RuleSet,
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +51,15 @@ def describe_endpoint(spec: EndpointSpec | None) -> str:
         places.append(f"{'else ' if places else ''}same function: {hints}")
     if spec.same_file:
         places.append(f"{'else ' if places else ''}same file")
+    if spec.created_by:
+        only = " only" if spec.created_only else ""
+        places.append(f"{'else ' if places else ''}made by{only}: {', '.join(spec.created_by)}")
+    if spec.value:
+        places.append(f"{'else ' if places else ''}{', '.join(spec.value)}")
+    if spec.naming:
+        places.append(f"{spec.naming} name")
+    if spec.data_type is not None:
+        places.append(f"type {_place(spec.data_type)}")
     return f"{spec.type}: {' / '.join(places)}" if places else spec.type
 
 
@@ -68,8 +85,11 @@ def config_row(rule: ConfigRule) -> RuleRow:
     when = "; ".join(f"{key} = {' | '.join(values)}" for key, values in rule.when)
     defaults = ", ".join(f"{key} = {value}" for key, value in rule.defaults)
     match = f"{', '.join(rule.files)}: [{'.'.join(rule.table)}]"
+    if rule.interpret:
+        match = f"{', '.join(rule.files)}: read as {rule.interpret}"
     match += f" where {when}" if when else ""
     match += f" (default {defaults})" if defaults else ""
+    match += f" (inside a folder with {rule.within})" if rule.within else ""
     pattern = f" ~ {rule.endpoint.pattern}" if rule.endpoint.pattern else ""
     return RuleRow(
         pack=rule.pack,
@@ -78,7 +98,9 @@ def config_row(rule: ConfigRule) -> RuleRow:
         match=match,
         kind=rule.kind.value,
         role=rule.role.value,
-        endpoint=f"{rule.endpoint.type}: key {rule.endpoint.key}{pattern}",
+        endpoint=f"{rule.endpoint.type}: key {rule.endpoint.key}{pattern}"
+        if rule.endpoint.key
+        else rule.endpoint.type,
     )
 
 
@@ -112,4 +134,33 @@ def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
                      row.requires)  # fmt: skip
             lines.append("| " + " | ".join(_code(c) for c in cells) + " |")
         lines.append("")
+        lines += _names_and_values(pack)
     return "\n".join(lines)
+
+
+def _place(place: Place | None) -> str:
+    if place is None:
+        return "-"
+    parts = [
+        f"template {place.template}" if place.template is not None else "",
+        f"arg {place.arg}" if place.arg is not None else "",
+        f"{place.keyword}=" if place.keyword else "",
+        f"{place.value!r}" if place.value is not None else "",
+    ]
+    return " / ".join(p for p in parts if p)
+
+
+def _names_and_values(pack: RulePack) -> list[str]:
+    """A pack's ``[[scopes]]`` and ``[[values]]``, a line each (they find no sites)."""
+    lines = [
+        f"- scope `{s.id}` ({s.kind}, {', '.join(s.languages)}): "
+        f"`{', '.join(s.match)}`, name {_place(s.name)}, namespace {_place(s.namespace)}"
+        for s in pack.scopes
+    ]
+    lines += [
+        f"- value `{v.id}` ({', '.join(v.languages)}): `{', '.join(v.match)}`, value "
+        f"{_place(v.value)}, parameter {_place(v.name)}"
+        + (f", written into arg {v.out}" if v.out is not None else "")
+        for v in pack.values
+    ]
+    return [*lines, ""] if lines else []

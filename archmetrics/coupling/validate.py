@@ -7,15 +7,17 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NoReturn
 
-from archmetrics.coupling.dynamic import normalize_callee
+from archmetrics.coupling.matching import normalize_callee
 from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
     KNOWN_LANGUAGES,
+    NAMINGS,
     EndpointSource,
     EndpointSpec,
     FunctionHint,
     LinkKind,
+    Place,
     Role,
     Rule,
     RulePack,
@@ -30,8 +32,10 @@ _RULE_KEYS = frozenset(
      "description", "example", "example_endpoint", "unless_from"}
 )  # fmt: skip
 _ENDPOINT_KEYS = frozenset(
-    {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file"}
-)
+    {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file", "value",
+     "created_by", "naming", "data_type", "created_only"}
+)  # fmt: skip
+_PLACE_KEYS = frozenset({"template", "arg", "keyword", "value"})
 _HINT_KEYS = frozenset({"match", "arg", "keyword"})
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 
@@ -91,9 +95,10 @@ def _list(values: frozenset[str]) -> str:
 def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
     """Validate one decoded TOML document and build its :class:`RulePack`."""
     from archmetrics.coupling.validate_config import parse_configuration
+    from archmetrics.coupling.validate_scopes import parse_scopes, parse_values
 
     top = Where(source)
-    top.table(data, "", frozenset({"pack", "rules", "configuration"}))
+    top.table(data, "", frozenset({"pack", "rules", "configuration", "scopes", "values"}))
     pack = top.table(data.get("pack"), "pack", _PACK_KEYS)
     name = top.text(pack, "name")
     if not _ID.match(name):
@@ -103,12 +108,15 @@ def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
         top.fail("rules", "a pack needs a non-empty [[rules]] or [[configuration]] array")
     rules = tuple(_parse_rule(raw, name, source, index) for index, raw in enumerate(raw_rules))
     configuration = parse_configuration(data.get("configuration", []), name, source)
+    scopes = parse_scopes(data.get("scopes", []), name, source)
+    values = parse_values(data.get("values", []), name, source)
     seen: set[str] = set()
-    for ident in [r.id for r in rules] + [r.id for r in configuration]:
+    for ident in [r.id for group in (rules, configuration, scopes, values) for r in group]:
         if ident in seen:
             Where(source, ident).fail("id", "duplicate rule id in this pack")
         seen.add(ident)
-    return RulePack(name, source, top.text(pack, "description", ""), rules, configuration)
+    description = top.text(pack, "description", "")
+    return RulePack(name, source, description, rules, configuration, "", scopes, values)
 
 
 def rule_header(
@@ -153,9 +161,7 @@ def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
     )
 
 
-def _examples(
-    where: Where, raw: object, languages: tuple[str, ...]
-) -> tuple[tuple[str, str], ...]:
+def _examples(where: Where, raw: object, languages: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
     """``example = "..."`` (in the rule's first language) or ``[rules.example]`` by language."""
     if raw is None:
         return ()
@@ -213,6 +219,16 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
     same_file = table.get("same_file", False)
     if not isinstance(same_file, bool):
         where.fail("same_file", "must be true or false")
+    created_by = where.texts(table, "created_by", required=False)
+    for match in created_by:
+        _check_glob(where, "created_by", match)
+    naming = table.get("naming")
+    if naming is not None and naming not in NAMINGS:
+        where.fail("naming", f"{naming!r} is not one of {_list(NAMINGS)}")
+    data_type = table.get("data_type")
+    created_only = table.get("created_only", False)
+    if not isinstance(created_only, bool) or (created_only and not created_by):
+        where.fail("created_only", "must be true or false, and true only with created_by")
     return EndpointSpec(
         type=where.choice(table, "type", ENDPOINT_TYPES),
         arg=where.integer(table, "arg"),
@@ -221,7 +237,31 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
         pattern=pattern,
         same_function=tuple(_parse_hint(where, hint) for hint in hints),
         same_file=same_file,
+        value=where.texts(table, "value", required=False),
+        created_by=created_by,
+        naming=naming if isinstance(naming, str) else None,
+        data_type=None if data_type is None else parse_place(where, data_type, "data_type"),
+        created_only=created_only,
     )
+
+
+def parse_place(where: Where, raw: object, key: str) -> Place:
+    """``{ template = 0 }``, ``{ arg = 1, keyword = "name" }`` or ``{ value = "~" }``."""
+    table = where.table(raw, key, _PLACE_KEYS)
+    try:
+        place = Place(
+            template=where.integer(table, "template"),
+            arg=where.integer(table, "arg"),
+            keyword=where.text(table, "keyword", "") or None,
+            value=where.text(table, "value", "") or None,
+        )
+    except RulePackError as error:
+        raise RulePackError(error.source, error.rule, f"{key}.{error.key}", error.problem) from None
+    if place == Place():
+        where.fail(key, "says nowhere: give template, arg, keyword or value")
+    if place.template is not None and place.template < 0:
+        where.fail(f"{key}.template", "template argument index must be >= 0")
+    return place
 
 
 def _parse_hint(where: Where, raw: object) -> FunctionHint:

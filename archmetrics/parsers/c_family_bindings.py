@@ -5,7 +5,8 @@ Three shapes, captured by the query (``@bind``): an object-like macro with a bod
 getenv("P")``, every declarator of ``int a = 1, b = 2;``, at any scope, a class member's
 ``static constexpr int P = 7;`` too) and a plain
 assignment to a name (``fd = socket(...)``, also inside a condition:
-``if ((fd = open(p)) < 0)``). The declared name is found through pointer, array, reference
+``if ((fd = open(p)) < 0)``) or to a member of ``this`` (``this->topic_ = "x"``, named
+``this->topic_``). The declared name is found through pointer, array, reference
 and parenthesized declarators; brace and constructor initializers (``int x{5}``,
 ``std::string s("x")``) and compound assignments (``+=``) bind nothing. The value's text is
 normalized as statement texts are.
@@ -26,6 +27,7 @@ _WRAPPERS = frozenset(
 )
 _NOT_ASSIGNED = frozenset({"argument_list", "initializer_list"})
 _NAMES = frozenset({"identifier", "field_identifier"})
+_ASSIGNED = frozenset({"identifier", "field_expression"})  # x = ..., this->x = ...
 
 
 def _declared(declarator: Node | None) -> Node | None:
@@ -54,7 +56,11 @@ def _parts(node: Node) -> tuple[Node | None, Node | None]:
     if operator is None or operator.type != "=":
         return None, None
     left = node.child_by_field_name("left")
-    return (left if left is not None and left.type == "identifier" else None), (
+    if left is not None and left.type == "field_expression":  # this->x = value
+        argument = left.child_by_field_name("argument")
+        if argument is None or argument.type != "this":
+            left = None
+    return (left if left is not None and left.type in _ASSIGNED else None), (
         node.child_by_field_name("right")
     )
 

@@ -9,8 +9,9 @@ deeper than 32 keys are not read (a warning says so); a file larger than
 :data:`MAX_BYTES`, with more than :data:`MAX_TABLES` mappings, nested deeper than the
 composer can follow, or that is not YAML, is not measured, with the reason. Each mapping is
 one :class:`ConfigTable`: its keys the mapping keys leading to it (sequence positions left
-out), its line, its scalar values (and sequences of scalars) as written, ``parent`` the index
-of the mapping holding it.
+out), its line (its key's, as a TOML table written inline takes its key's line; a mapping in
+a sequence, where it starts), its scalar values (and sequences of scalars) as written,
+``parent`` the index of the mapping holding it.
 """
 
 from __future__ import annotations
@@ -73,11 +74,11 @@ class _Walk:
         self.failure = ""
 
     def read(self, root: yaml.Node | None) -> None:
-        pending: list[tuple[yaml.Node, tuple[str, ...], int]] = []
+        pending: list[tuple[yaml.Node, tuple[str, ...], int, int]] = []
         if root is not None:
-            pending.append((root, (), -1))
+            pending.append((root, (), -1, 0))
         while pending and not self.failure:
-            node, keys, parent = pending.pop()
+            node, keys, parent, line = pending.pop()
             if id(node) in self.seen:
                 continue  # an alias: read where its anchor is
             self.seen.add(id(node))
@@ -85,19 +86,21 @@ class _Walk:
             if self.nodes > MAX_NODES:
                 self.failure = f"more than {MAX_NODES:,} nodes; not read as configuration"
             elif isinstance(node, yaml.SequenceNode):
-                pending.extend((item, keys, parent) for item in reversed(node.value))
+                pending.extend((item, keys, parent, 0) for item in reversed(node.value))
             elif isinstance(node, yaml.MappingNode):
-                pending.extend(reversed(self._mapping(node, keys, parent)))
+                pending.extend(reversed(self._mapping(node, keys, parent, line)))
 
     def _mapping(
-        self, node: yaml.MappingNode, keys: tuple[str, ...], parent: int
-    ) -> list[tuple[yaml.Node, tuple[str, ...], int]]:
+        self, node: yaml.MappingNode, keys: tuple[str, ...], parent: int, line: int
+    ) -> list[tuple[yaml.Node, tuple[str, ...], int, int]]:
+        """The table of a mapping, on ``line`` (its key's; 0: where it starts), and the
+        nodes below it to walk."""
         if len(keys) > MAX_KEYS:
             self.deep = True
             return []
         index = len(self.tables)
         values: list[tuple[str, tuple[str, ...]]] = []
-        children: list[tuple[yaml.Node, tuple[str, ...], int]] = []
+        children: list[tuple[yaml.Node, tuple[str, ...], int, int]] = []
         for key, value in node.value:
             if not isinstance(key, yaml.ScalarNode):
                 continue
@@ -106,8 +109,9 @@ class _Walk:
             elif isinstance(value, yaml.SequenceNode) and (texts := tuple(_scalars(value))):
                 values.append((key.value, texts))
             if not isinstance(value, yaml.ScalarNode):
-                children.append((value, (*keys, key.value), index))
-        self.tables.append(ConfigTable(keys, node.start_mark.line + 1, tuple(values), parent))
+                children.append((value, (*keys, key.value), index, key.start_mark.line + 1))
+        written = line or node.start_mark.line + 1
+        self.tables.append(ConfigTable(keys, written, tuple(values), parent))
         if len(self.tables) > MAX_TABLES:
             self.failure = f"more than {MAX_TABLES:,} mappings; not read as configuration"
         return children

@@ -4,8 +4,9 @@ Both readers (``ast``'s and libcst's) produce the same token stream, so both rea
 here from the tokens of each ``assign`` and ``annassign`` statement: the statement splits at
 its top-level ``=`` tokens (not inside brackets, not after a ``lambda``, whose defaults are
 part of the value); every part before the last that is one plain name is bound to the last
-part, the value (``x = y = 1`` binds both). ``x: int = 1`` binds ``x``; ``a, b = f()`` and
-``self.x = 1`` bind no plain name and give none.
+part, the value (``x = y = 1`` binds both). ``x: int = 1`` binds ``x``; ``self.x = 1`` (or
+``cls.x``) binds ``self.x``, a member of the object at hand; ``a, b = f()`` and ``o.x = 1``
+give none.
 """
 
 from __future__ import annotations
@@ -45,10 +46,20 @@ def assignment_bindings(kind: str, tokens: list[str]) -> list[tuple[str, str]]:
         target = tokens[start:cut]
         if kind == "annassign" and len(target) >= 2 and target[1] == ":":
             target = target[:1]
-        if len(target) == 1 and _is_name(target[0]) and value:
-            found.append((target[0], value))
+        if value and ((len(target) == 1 and _is_name(target[0])) or _own_member(target)):
+            found.append(("".join(target), value))
         start = cut + 1
     return found
+
+
+def _own_member(tokens: list[str]) -> bool:
+    """Whether ``tokens`` are a member of the object or class at hand: ``self.x``, ``cls.x``."""
+    return (
+        len(tokens) == 3
+        and tokens[0] in ("self", "cls")
+        and tokens[1] == "."
+        and (_is_name(tokens[2]))
+    )
 
 
 def _dotted(tokens: list[str]) -> bool:

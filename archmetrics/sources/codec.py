@@ -46,7 +46,7 @@ from archmetrics.facts import (
     statements_digest,
 )
 
-FORMAT = 9
+FORMAT = 10
 BODY_LINES = 3  # call sites, statements, bindings
 
 _new = tuple.__new__

@@ -105,24 +105,24 @@ def test_each_yaml_mapping_is_a_table_with_its_scalars_line_and_parent() -> None
     assert facts.parsed, facts.warnings
     assert list(facts.tables) == [
         ConfigTable((), 1, (), -1),
-        ConfigTable(("controller_server",), 2, (), 0),
+        ConfigTable(("controller_server",), 1, (), 0),  # a mapping's line: its key's
         ConfigTable(
             ("controller_server", "ros__parameters"),
-            3,
+            2,
             (("controller_frequency", ("20.0",)), ("plugins", ("FollowPath",))),
             1,
         ),
         ConfigTable(
             ("controller_server", "ros__parameters", "FollowPath"),
-            6,
+            5,
             (("plugin", ("dwb_core::DWBLocalPlanner",)),),
             2,
         ),
-        ConfigTable(("/**",), 8, (), 0),
-        ConfigTable(("/**", "ros__parameters"), 9, (("use_sim_time", ("true",)),), 4),
-        ConfigTable(("launch",), 11, (), 0),
+        ConfigTable(("/**",), 7, (), 0),
+        ConfigTable(("/**", "ros__parameters"), 8, (("use_sim_time", ("true",)),), 4),
+        ConfigTable(("launch",), 11, (), 0),  # in a sequence: where the mapping starts
         ConfigTable(
-            ("launch", "node"), 12, (("pkg", ("demo_nodes_cpp",)), ("exec", ("talker",))), 6
+            ("launch", "node"), 11, (("pkg", ("demo_nodes_cpp",)), ("exec", ("talker",))), 6
         ),
         ConfigTable(
             ("launch", "node", "remap"), 15, (("from", ("chatter",)), ("to", ("chat",))), 7

@@ -1,0 +1,129 @@
+"""A link site's graph name, resolved, and its data type (rules with ``naming``, ``value``
+or ``data_type`` in their endpoint; docs/metrics.md, "ROS: names and types").
+
+The endpoint a rule reads (``topic:chatter``) is a name as written; with ``naming = "ros"``
+it is resolved against the node and handle the call is made in (scopes.py):
+``topic:/chatter``, ``topic:/talker/state`` for ``~/state``, ``parameter:/talker/rate`` for a
+parameter. A name that cannot be resolved statically (a private name in a node whose name is
+computed) leaves the site without an endpoint, its note saying why, its name kept. The data
+type is read as written and spelled as ROS's tools spell it (``geometry_msgs/msg/Twist``);
+in Python a type imported by name is read through its import.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+from archmetrics.coupling.endpoints import normalize
+from archmetrics.coupling.matching import constructed
+from archmetrics.coupling.model import Endpoint, LinkSite
+from archmetrics.coupling.rosnames import NodeName, UnresolvedName, interface_type, resolve
+from archmetrics.coupling.rules import EndpointSpec, Place
+from archmetrics.coupling.scopes import FileScopes
+from archmetrics.coupling.values import pick
+from archmetrics.facts import CallSite, Dependency
+
+
+def imported_names(dependencies: Sequence[Dependency]) -> dict[str, str]:
+    """The names a Python file's imports bind, each to the dotted name it stands for
+    (``Twist`` -> ``geometry_msgs.msg.Twist`` after ``from geometry_msgs.msg import Twist``)."""
+    found: dict[str, str] = {}
+    for dependency in dependencies:
+        if dependency.level:
+            continue
+        if not dependency.names:
+            for bound in dependency.bound:  # import a.b as c: c is a.b
+                if bound != dependency.target.split(".")[0]:
+                    found[bound] = dependency.target
+            continue
+        for name, bound in zip(dependency.names, dependency.bound, strict=False):
+            found[bound] = f"{dependency.target}.{name}"
+    return found
+
+
+def data_type(call: CallSite, place: Place | None, imports: Mapping[str, str]) -> str:
+    """The data type a call names at ``place`` (a template argument or an argument), as ROS
+    spells it; "" when it names none."""
+    if place is None:
+        return ""
+    if place.value is not None:
+        return interface_type(place.value)
+    written: str | None = None
+    if place.template is not None:
+        _, templates = constructed(call)
+        written = templates[place.template] if place.template < len(templates) else None
+    else:
+        argument = pick(call.arguments, place)
+        written = argument.text if argument is not None else None
+    if not written:
+        return ""
+    head, dot, rest = written.replace(" ", "").partition(".")
+    if head in imports:
+        written = imports[head] + dot + rest
+    return interface_type(written)
+
+
+@dataclass(frozen=True, slots=True)
+class Named:
+    """What the graph-name reading adds to a site."""
+
+    endpoint: Endpoint | None
+    note: str
+    name: str = ""
+    node: str = ""
+
+
+def graph_endpoint(
+    spec: EndpointSpec, call: CallSite, found: Endpoint | None, note: str, scopes: FileScopes
+) -> Named:
+    """The site's endpoint with its names resolved (``spec.naming``), or fixed
+    (``spec.value``): the first name is the endpoint, the others keys it also receives on."""
+    names = list(spec.value)
+    if not names and found is not None:
+        names = [found.key.partition(":")[2]]
+    if not names:
+        return Named(None, note)
+    if spec.naming is None:
+        keys = [key for name in names if (key := normalize(spec.type, name))]
+        text = found.text if found is not None else names[0]
+        via = found.via if found is not None else "fixed"
+        return Named(Endpoint(keys[0], text, via, tuple(keys[1:])) if keys else None, note)
+    if spec.type == "parameter" and spec.naming == "ros":  # a ROS 2 node's own parameter
+        names = [f"~/{name.lstrip('/~')}" for name in names]
+    node, handle = scopes.context(call)
+    written = f"{spec.type}:{folded(names[0], handle)}"
+    qualified = node.fully_qualified or ""
+    try:
+        resolved = [_resolved(spec, name, node, handle) for name in names]
+    except UnresolvedName as why:
+        return Named(None, note or str(why), written, qualified)
+    text = found.text if found is not None else names[0]
+    via = found.via if found is not None else "fixed"
+    point = Endpoint(resolved[0], text, via, tuple(resolved[1:]))
+    return Named(point, note, written, qualified)
+
+
+def folded(name: str, handle: str | None) -> str:
+    """``name`` as it reads without the ROS 1 NodeHandle it was given to (``scan`` on a
+    handle made with ``"~"`` is ``~/scan``), so that it resolves alike later (rosgraph.py)."""
+    if handle is None or not handle.strip() or name.startswith(("/", "~")):
+        return name
+    return f"{handle.rstrip('/')}/{name}"
+
+
+def _resolved(spec: EndpointSpec, name: str, node: NodeName, handle: str | None) -> str:
+    return f"{spec.type}:{resolve(name, node, handle)}"
+
+
+def completed(site: LinkSite, named: Named, kind_of_data: str, parameter: str) -> LinkSite:
+    """``site`` with what the graph-name reading found."""
+    return replace(
+        site,
+        endpoint=named.endpoint,
+        note=named.note,
+        name=named.name,
+        node=named.node,
+        data_type=kind_of_data,
+        parameter=parameter,
+    )

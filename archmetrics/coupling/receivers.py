@@ -1,0 +1,87 @@
+"""A call on an object takes the endpoint of the call that made the object (a rule's
+``created_by``): ``pub_->publish(msg)`` publishes where ``pub_ =
+create_publisher<T>("cmd_vel", 10)`` said, ``self.cli.call_async(req)`` calls the service
+``self.cli = self.create_client(AddTwoInts, "add_two_ints")`` named.
+
+The object is matched by name (``this->pub_`` and ``pub_`` are one member) among the file's
+link sites whose call's value was assigned to it (facts.CallSite.target), preferring a
+making call in the same class; two makers with different endpoints leave the site unknown,
+its note listing them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+from archmetrics.coupling.matching import constructed, matches
+from archmetrics.coupling.model import LinkSite
+from archmetrics.coupling.rules import Rule
+from archmetrics.coupling.scopes import owner, receiver_of
+from archmetrics.coupling.trace import member
+from archmetrics.facts import CallSite
+
+
+@dataclass(frozen=True, slots=True)
+class Found:
+    """A link site as first read, with the rule and the call that made it."""
+
+    rule: Rule
+    site: LinkSite
+    call: CallSite | None  # None for a definition site
+
+
+def _makers(found: Found, everything: Sequence[Found]) -> list[Found]:
+    spec = found.rule.endpoint
+    receiver = receiver_of(found.call) if found.call is not None else None
+    if spec is None or receiver is None:
+        return []
+    makers = [
+        other
+        for other in everything
+        if other.call is not None
+        and other.call.target is not None
+        and member(other.call.target) == receiver
+        and any(matches(p, constructed(other.call)[0]) for p in spec.created_by)
+    ]
+    mine = owner(found.site.function)
+    same_class = [m for m in makers if owner(m.site.function) == mine]
+    return same_class or makers
+
+
+def bound_to_makers(found: Sequence[Found]) -> list[Found]:
+    """Each site of ``found`` whose rule says ``created_by`` and that has no endpoint of its
+    own, given the endpoint, name, node, data type and parameter of its object's maker; a
+    site whose rule says ``created_only`` and whose object no call of the file made is left
+    out (a method name too common to count on any receiver: ``call``)."""
+    done = []
+    for item in found:
+        spec = item.rule.endpoint
+        if spec is None or not spec.created_by or item.site.endpoint is not None:
+            done.append(item)
+            continue
+        receiver = receiver_of(item.call) if item.call is not None else None
+        if receiver in (None, "this", "self", "(*this)"):
+            continue  # a method of the class itself (this->publish()): no object made
+        makers = _makers(item, found)
+        if not makers and spec.created_only:
+            continue  # no object this file makes: no link (``subprocess.call``)
+        points = {m.site.endpoint.key for m in makers if m.site.endpoint is not None}
+        site = item.site
+        if len(points) > 1:
+            listed = ", ".join(sorted(points))
+            site = replace(site, note=f"made by several calls: {listed}")
+        elif makers:
+            maker = next((m for m in makers if m.site.endpoint is not None), makers[0])
+            made = maker.site
+            endpoint = None if made.endpoint is None else replace(made.endpoint, via="receiver")
+            site = replace(
+                site, endpoint=endpoint, note=made.note if endpoint is None else "",
+                name=made.name, node=made.node, data_type=site.data_type or made.data_type,
+                parameter=made.parameter,
+            )  # fmt: skip
+        elif not site.note:
+            receiver = receiver_of(item.call) if item.call is not None else None
+            site = replace(site, note=f"{receiver or 'the object'} is not made in this file")
+        done.append(Found(item.rule, site, item.call))
+    return done
