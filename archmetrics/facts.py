@@ -193,6 +193,7 @@ class ConfigFormat(StrEnum):
     TOML = "toml"
     XML = "xml"
     YAML = "yaml"
+    ROSIDL = "rosidl"  # a ROS interface definition (.msg, .srv, .action): listed, λ = 0
 
 
 class ConfigTable(NamedTuple):

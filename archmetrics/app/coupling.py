@@ -26,6 +26,7 @@ def coupling_options(settings: Settings) -> CouplingOptions:
         ignore_imports=c.ignore_imports,
         include_dirs=c.include_dirs,
         per_file=c.per_file,
+        group=c.group,
     )
 
 

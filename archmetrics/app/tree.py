@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from archmetrics.app.diff import DiffOptions
 
 STATE_RECORD = "tree-state/1"
+_CONFIGURATION = frozenset({"xml", "yaml"})  # a tree holding these is ROS: patched whole
 PATCH_LIMIT = 0.25  # a delta touching more than this share of a tree's files: built whole
 
 
@@ -181,7 +182,7 @@ def whole_side(
     rows = tuple(FileRow.of(f, blobs[f.path]) for f in facts)
     progress.phase(f"coupling {snapshot.label}")
     index = _couple(facts, rows, options, cache)
-    state = tree_state(rows, index, options.rules, options.coupling.per_file)
+    state = tree_state(rows, index, options.rules, options.coupling.grouping)
     return Side(snapshot, state, cache, {f.path: f for f in facts})
 
 
@@ -249,7 +250,7 @@ def _patched(
         index = _patched_index(origin, side, changed, options, cache)
     except MissingFacts:  # the cache lost a file's facts since the state was kept
         return None
-    rules, per_file = options.rules, options.coupling.per_file
+    rules, per_file = options.rules, options.coupling.grouping
     side.state = patched_state(origin.state, rows, index, changed, rules, per_file, origin.owner)
     return side
 
@@ -290,8 +291,10 @@ def _patched_index(
         return row is not None and row.parsed and exclusion(row, rules) is None
 
     redone: dict[str, FileFacts] = {}
-    if origin.state.index.whole or any(
-        configures(side.facts(path)) for path in changed if path in side.by_path
+    if (
+        origin.state.index.whole
+        or any(row.language in _CONFIGURATION for row in origin.state.rows)
+        or any(configures(side.facts(path)) for path in changed if path in side.by_path)
     ):  # launch, parameter or plugin files rename sites or receive them (rosgraph.py)
         facts = [side.facts(row.path) for row in measured_files(side.state.rows, rules)]
         return _couple(facts, side.state.rows, options, cache)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -132,9 +133,14 @@ def _with_excludes(
     load: Callable[[Path, tuple[str, ...]], Settings], path: Path, args: argparse.Namespace | None
 ) -> Settings:
     try:
-        return load(path, tuple(getattr(args, "exclude", None) or ()))
+        settings = load(path, tuple(getattr(args, "exclude", None) or ()))
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
+    group = getattr(args, "group", None)
+    if group is not None:  # --group over [tool.archmetrics.coupling] group
+        coupling = dataclasses.replace(settings.coupling, group=group, per_file=group == "file")
+        settings = dataclasses.replace(settings, coupling=coupling)
+    return settings
 
 
 def emit(text: str, output: Path | None) -> None:

@@ -42,6 +42,16 @@ def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
     add_exclude(parser)
 
 
+def add_group(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--group",
+        choices=["component", "file", "package", "node"],
+        default=None,
+        help="what one element is: a C/C++ header and its source (component, the default), a"
+        " file, a ROS package (the folder holding package.xml) or a ROS node's files",
+    )
+
+
 def add_exclude(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--exclude",
@@ -154,6 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
         " exit 1 when a function, file, element or the total fails it (repeatable)",
     )
     add_output(scan, [f.value for f in OutputFormat])
+    add_group(scan)
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
@@ -172,6 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
+    add_group(diff)
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -261,7 +273,16 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    graph.add_argument(
+        "--view",
+        choices=["elements", "computation"],
+        default=None,
+        help="elements: who depends on and talks to whom; computation: elements and the"
+        " topics, services, actions and plugins between them, as rqt_graph draws a ROS graph"
+        " (default: computation when the tree has ROS sites, else elements)",
+    )
     add_exclude(graph)
+    add_group(graph)
     docs = commands.add_parser(
         "docs", help="the documentation installed with archmetrics: list the pages, print one"
     )

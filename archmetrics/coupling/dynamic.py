@@ -17,7 +17,13 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from archmetrics.coupling.endpoints import normalize
-from archmetrics.coupling.graphnames import completed, data_type, graph_endpoint
+from archmetrics.coupling.graphnames import (
+    completed,
+    data_type,
+    graph_endpoint,
+    imported_names,
+    qualified,
+)
 from archmetrics.coupling.matching import (
     RuleIndex,
     choose_rule,
@@ -42,7 +48,7 @@ from archmetrics.coupling.rules import (
 )
 from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader
-from archmetrics.facts import Argument, CallSite, FileFacts
+from archmetrics.facts import Argument, CallSite, FileFacts, Language
 
 __all__ = [
     "AmbiguousEndpoint", "FileContext", "LinkFilter", "RuleIndex", "choose_rule",
@@ -142,6 +148,10 @@ def _read_endpoint(
         found = _first_matching(call, spec, read)
     else:
         found = _key_from(_pick(call.arguments, spec.arg, spec.keyword), spec, read, call)
+        for index in spec.more_args if found is None else ():
+            found = _key_from(_pick(call.arguments, index, None), spec, read, call)
+            if found is not None:
+                break
     if found is None and spec.same_function:
         found = _from_function(call, spec.same_function, spec, calls, read)
     return found
@@ -167,6 +177,10 @@ class LinkFilter:
         calls, definitions = indexes
         if calls.may_match(facts.callees()):
             return True
+        if facts.language == Language.PYTHON and facts.dependencies:  # callees as imported
+            imports = imported_names(facts.dependencies)
+            if imports and calls.may_match(qualified(c, imports) for c in facts.callees()):
+                return True
         return definitions.may_match(f.qualified_name for f in facts.functions)
 
 
@@ -192,7 +206,12 @@ def file_link_sites(
         callee, _ = constructed(call)
         receiver = normalize_callee(call.receiver) if call.receiver else None
         rule = calls.choose(callee, receiver in modules)
+        if rule is None and context is not None and context.imports:  # as imported
+            named = qualified(callee, context.imports)
+            rule = calls.choose(named, receiver in modules) if named != callee else None
         if rule and not (rule.unless_from and _assigned_from(facts, call, rule.unless_from)):
+            if _bare(call, rule):
+                continue
             found.append(Found(rule, _call_site(facts, call, rule, read, context), call))
     definitions = rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION))
     for function in facts.functions:
@@ -219,19 +238,39 @@ def _call_site(
     and its data type read where the rule says so."""
     spec = rule.endpoint
     endpoint, note = read_endpoint(call, spec, facts.call_sites, read)
-    if endpoint is None and not note and spec is not None and spec.naming and not spec.created_by:
-        note = _unknown(call, spec)  # graph names: why one is unknown is always said
+    if (
+        endpoint is None
+        and not note
+        and spec is not None
+        and not spec.created_by
+        and (spec.naming or spec.type in _SAID)
+    ):
+        note = _unknown(call, spec)  # graph names, plugins, launched nodes: always said why
     site = replace(_site(facts.path, call.span.start, rule, call.callee, endpoint, call.function),
                    note=note)  # fmt: skip
     if spec is None or context is None or not (spec.naming or spec.value or spec.data_type):
         return site
-    kind = data_type(call, spec.data_type, context.imports)
+    kind = data_type(call, spec.data_type, context.imports, spec.naming == "ros1")
     if spec.created_by and endpoint is None:
         return replace(site, data_type=kind)  # its maker gives it (receivers.py)
     parameter = endpoint.via.partition(":")[2] if endpoint and endpoint.via.startswith(
         "parameter:") else ""  # fmt: skip
     named = graph_endpoint(spec, call, endpoint, note, context.scopes)
     return completed(site, named, kind, parameter)
+
+
+_SAID = frozenset({"plugin", "node"})
+
+
+def _bare(call: CallSite, rule: Rule) -> bool:
+    """A call without arguments where a graph-name rule reads its name from one
+    (``filter->subscribe()`` re-subscribing a subscriber made elsewhere): no new link."""
+    spec = rule.endpoint
+    return (
+        spec is not None and spec.naming is not None and not call.arguments
+        and (spec.arg is not None or spec.keyword is not None)
+        and not spec.value and not spec.created_by
+    )  # fmt: skip
 
 
 def _unknown(call: CallSite, spec: EndpointSpec) -> str:

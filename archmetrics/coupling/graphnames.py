@@ -42,9 +42,31 @@ def imported_names(dependencies: Sequence[Dependency]) -> dict[str, str]:
     return found
 
 
-def data_type(call: CallSite, place: Place | None, imports: Mapping[str, str]) -> str:
+def qualified(callee: str, imports: Mapping[str, str]) -> str:
+    """A Python callee with the name it starts with read through the file's imports
+    (``Node`` -> ``launch_ros.actions.Node`` after ``from launch_ros.actions import Node``);
+    as written when that name is no import."""
+    head, dot, rest = callee.replace(" ", "").partition(".")
+    found = imports.get(head)
+    return f"{found}{dot}{rest}" if found else callee
+
+
+def data_type(
+    call: CallSite, place: Place | None, imports: Mapping[str, str], ros1: bool = False
+) -> str:
     """The data type a call names at ``place`` (a template argument or an argument), as ROS
-    spells it; "" when it names none."""
+    spells it (ROS 1: ``std_msgs/String``, also for Python's ``std_msgs.msg.String``); ""
+    when it names none."""
+    found = _data_type(call, place, imports)
+    if ros1:
+        package, _, rest = found.partition("/")
+        kind, _, name = rest.partition("/")
+        if name and kind in ("msg", "srv", "action"):
+            return f"{package}/{name}"
+    return found
+
+
+def _data_type(call: CallSite, place: Place | None, imports: Mapping[str, str]) -> str:
     if place is None:
         return ""
     if place.value is not None:

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 _SPECIAL = re.compile(r"[\s()<>:]|->")
 _TEMPLATE = re.compile(r"<[^<>]*>")
 _PARENS = re.compile(r"\([^()]*\)")
+_TEMPLATE_KEYWORD = re.compile(r"(?<=[.>:])\s*template\s+")
 MAKERS = frozenset(
     {"std.make_shared", "std.make_unique", "make_shared", "make_unique", "boost.make_shared"}
 )
@@ -43,7 +44,8 @@ def normalize_callee(callee: str) -> str:
     """A callee as rules see it: no spaces, no template arguments, ``->``/``::`` as ``.``."""
     if not _SPECIAL.search(callee):
         return callee.lstrip(".")
-    text = re.sub(r"\s+", "", callee)
+    text = _TEMPLATE_KEYWORD.sub("", callee)  # node->template create_client<T>
+    text = re.sub(r"\s+", "", text)
     text = _strip_nested(_PARENS, _strip_nested(_TEMPLATE, text, ""), "()")
     return text.replace("->", ".").replace("::", ".").lstrip(".")
 
@@ -82,16 +84,16 @@ def matches(pattern: str, callee: str) -> bool:
 def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
     """Every way a ``requires`` entry can name a dependency: the dependency itself, its dotted
     prefixes (``zmq`` for ``zmq.asyncio``), its path suffixes (``playerc.h`` for
-    ``libplayerc/playerc.h``) and its first folder with its slash (``rclcpp/`` for
-    ``rclcpp/rclcpp.hpp``: any header of that library)."""
+    ``libplayerc/playerc.h``) and each of its folders with a slash (``rclcpp/`` for
+    ``rclcpp/rclcpp.hpp``: any header of that library; ``msg/`` for
+    ``geometry_msgs/msg/twist.hpp``: any generated message header)."""
     forms: set[str] = set()
     for dep in dependencies:
         parts = dep.split(".")
         forms.update(".".join(parts[: i + 1]) for i in range(len(parts)))
         pieces = dep.split("/")
         forms.update("/".join(pieces[i:]) for i in range(len(pieces)))
-        if len(pieces) > 1:
-            forms.add(pieces[0] + "/")
+        forms.update(piece + "/" for piece in pieces[:-1])  # rclcpp/, msg/ (any header there)
     return frozenset(forms)
 
 

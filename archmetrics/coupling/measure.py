@@ -77,7 +77,7 @@ def link_tree(
     rules = rules or RuleSet()
     by_path = {f.path: f for f in files}
     languages = {f.path: f.language for f in files}
-    elements = group_elements(by_path, options.per_file, languages.get)
+    elements = group_elements(by_path, options.grouping, languages.get)
     resolver = StaticResolver(tuple(by_path), options)
     occurrences = {path: resolver.resolve_file(facts) for path, facts in by_path.items()}
     may_link = LinkFilter(rules)

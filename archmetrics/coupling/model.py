@@ -25,6 +25,12 @@ class CouplingOptions:
     include_dirs: tuple[str, ...] = ()
     per_file: bool = False
     python_roots: tuple[str, ...] | None = None
+    group: str = "component"  # component | file | package | node (elements.py)
+
+    @property
+    def grouping(self) -> str:
+        """How files are grouped into elements: ``per_file`` is ``"file"``."""
+        return "file" if self.per_file else self.group
 
 
 class Resolution(StrEnum):

@@ -129,9 +129,10 @@ def launched_elements(
     }  # fmt: skip
     if by_node:
         return by_node
+    wanted = {entry.executable, PurePosixPath(entry.executable).stem}  # ROS 1's talker.py
     return {
         e.name for e in inside
-        if any(PurePosixPath(p).stem == entry.executable for p in e.files)
+        if any(PurePosixPath(p).stem in wanted for p in e.files)
     }  # fmt: skip
 
 

@@ -19,14 +19,13 @@ import ast
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
+from archmetrics.coupling.graphnames import imported_names, qualified
 from archmetrics.coupling.matching import matches, requirement_met
 from archmetrics.facts import CallSite, ConfigTable, FileFacts, Language
 
 _PUSHES = (("push-ros-namespace",), ("push_ros_namespace",))
-NODE_CALLS = ("Node", "launch_ros.actions.Node", "actions.Node")
-COMPONENT_CALLS = (
-    "ComposableNode", "launch_ros.descriptions.ComposableNode", "descriptions.ComposableNode",
-)  # fmt: skip
+NODE_CALLS = ("launch_ros.actions.Node", "actions.Node")
+COMPONENT_CALLS = ("launch_ros.descriptions.ComposableNode", "descriptions.ComposableNode")
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,9 +112,11 @@ def python_launched(facts: FileFacts) -> Iterator[Launched]:
         ("launch_ros",), [d.target for d in facts.dependencies]
     ):
         return
+    imports = imported_names(facts.dependencies)
     for call in facts.call_sites:
-        component = any(matches(p, call.callee) for p in COMPONENT_CALLS)
-        if not component and not any(matches(p, call.callee) for p in NODE_CALLS):
+        callee = qualified(call.callee, imports)
+        component = any(matches(p, callee) for p in COMPONENT_CALLS)
+        if not component and not any(matches(p, callee) for p in NODE_CALLS):
             continue
         text = {
             key: _named(facts, call, _keyword(call, names))

@@ -49,7 +49,9 @@ ENDPOINT_TYPES = frozenset(
 )  # fmt: skip
 NAMINGS = frozenset({"ros", "ros1"})  # how names resolve (coupling/rosnames.py)
 # configuration files read by code that knows their format's meaning (coupling/roslinks.py)
-INTERPRETERS = frozenset({"ros-parameters", "ros-launch", "pluginlib", "ros-package"})
+INTERPRETERS = frozenset(
+    {"ros-parameters", "ros-launch", "pluginlib", "ros-package", "ros-interface"}
+)
 KNOWN_LANGUAGES = frozenset(str(lang) for lang in Language)
 
 
@@ -109,6 +111,9 @@ class EndpointSpec:
     data_type: Place | None = None  # where the message, service or action type is
     # with created_by: a call on an object no call of the file made is no link (``call``)
     created_only: bool = False
+    # positions tried after ``arg`` when it gives nothing (an overload with more arguments:
+    # rclcpp_action::create_client(base, graph, logging, waitables, name))
+    more_args: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

@@ -38,7 +38,8 @@ def describe_endpoint(spec: EndpointSpec | None) -> str:
         return f"{spec.type}: callee ~ {spec.pattern}"
     places = []
     if spec.arg is not None:
-        places.append(f"arg {spec.arg}")
+        more = "".join(f" or {index}" for index in spec.more_args)
+        places.append(f"arg {spec.arg}{more}")
     if spec.keyword is not None:
         places.append(f"{spec.keyword}=")
     if spec.pattern is not None:

@@ -74,6 +74,8 @@ class Where:
 
     def integer(self, table: Mapping[str, object], key: str) -> int | None:
         value = table.get(key)
+        if key == "arg" and isinstance(value, list) and value:  # [1, 4]: 1, else 4
+            value = value[0]
         if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
             self.fail(key, f"must be an integer, got {value!r}")
         if isinstance(value, int) and key == "arg" and value < 0:
@@ -226,6 +228,13 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
     if naming is not None and naming not in NAMINGS:
         where.fail("naming", f"{naming!r} is not one of {_list(NAMINGS)}")
     data_type = table.get("data_type")
+    raw_arg = table.get("arg")
+    more_args: tuple[int, ...] = ()
+    if isinstance(raw_arg, list):
+        if not raw_arg or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 0
+                                  for a in raw_arg):  # fmt: skip
+            where.fail("arg", "a list of argument indexes must hold integers >= 0")
+        more_args = tuple(raw_arg[1:])
     created_only = table.get("created_only", False)
     if not isinstance(created_only, bool) or (created_only and not created_by):
         where.fail("created_only", "must be true or false, and true only with created_by")
@@ -242,6 +251,7 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
         naming=naming if isinstance(naming, str) else None,
         data_type=None if data_type is None else parse_place(where, data_type, "data_type"),
         created_only=created_only,
+        more_args=more_args,
     )
 
 

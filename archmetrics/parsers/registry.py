@@ -91,6 +91,12 @@ def _yaml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileF
     return config_yaml.parse(path, source, limits)
 
 
+def _rosidl(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    """A ROS interface definition: no executable code, no table; listed so that the
+    includes and imports of the code generated from it depend on it (coupling/interfaces.py)."""
+    return FileFacts(path=path, language=ConfigFormat.ROSIDL.value)
+
+
 BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     LanguageSpec(Language.PYTHON, _python, _python),
     LanguageSpec(Language.C, _c, _c),
@@ -100,6 +106,7 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     LanguageSpec(ConfigFormat.TOML, _toml, _toml),
     LanguageSpec(ConfigFormat.XML, _xml, _xml),
     LanguageSpec(ConfigFormat.YAML, _yaml, _yaml),
+    LanguageSpec(ConfigFormat.ROSIDL, _rosidl, _rosidl),
 )
 
 

@@ -152,13 +152,17 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     changed = [diff_rows.element_row(e) for e in report.change.changed()]
     least_useful = ("d_e", "d_a", "s_e", "s_a", "location", "λ pre", "v_g pre")
     detail = rows_table("elements", diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
+    linked = diff_rows.link_rows(report.change.changed())
+    tables = [summary, detail]
+    if linked:
+        tables.append(rows_table("links added and removed", diff_rows.LINK_HEADER, linked, 1))
     unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
     lines += [str(f) for f in report.failures]
-    return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
+    return to_text(*tables, color=color) + "".join(line + "\n" for line in lines)
 
 
 def render_series(report: SeriesReport, color: bool = False) -> str:
