@@ -25,6 +25,7 @@ from archmetrics.coupling.graphnames import (
     qualified,
 )
 from archmetrics.coupling.matching import (
+    Requirements,
     RuleIndex,
     choose_rule,
     constructed,
@@ -193,11 +194,8 @@ def file_link_sites(
     context: FileContext | None = None,
 ) -> tuple[LinkSite, ...]:
     """The unresolved-yet link sites of one file (status and targets are set by ``resolve``)."""
-    forms = requirement_forms(visible)
-    usable = [
-        r for r in rules.for_language(facts.language)
-        if not r.requires or any(want in forms for want in r.requires)
-    ]  # fmt: skip
+    seen = Requirements(visible)
+    usable = [r for r in rules.for_language(facts.language) if seen.met(r.requires)]
     calls = rule_index(tuple(r for r in usable if r.site is SiteKind.CALL))
     found: list[Found] = []
     # a file none of whose callees a rule names has no call site to read (nor to decode)

@@ -76,6 +76,7 @@ def _compiled(pattern: str) -> GitIgnoreSpec:
     return compile_glob(normalize_callee(pattern))
 
 
+@lru_cache(maxsize=1 << 16)
 def matches(pattern: str, callee: str) -> bool:
     """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches."""
     return _compiled(pattern).match_file(normalize_callee(callee))
@@ -89,19 +90,47 @@ def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
     ``geometry_msgs/msg/twist.hpp``: any generated message header)."""
     forms: set[str] = set()
     for dep in dependencies:
-        parts = dep.split(".")
-        forms.update(".".join(parts[: i + 1]) for i in range(len(parts)))
-        pieces = dep.split("/")
-        forms.update("/".join(pieces[i:]) for i in range(len(pieces)))
-        forms.update(piece + "/" for piece in pieces[:-1])  # rclcpp/, msg/ (any header there)
+        forms.update(_forms_of(dep))
     return frozenset(forms)
+
+
+@lru_cache(maxsize=1 << 15)
+def _forms_of(dep: str) -> tuple[str, ...]:
+    """The forms of one dependency (the same headers reach most files of a tree)."""
+    parts = dep.split(".")
+    pieces = dep.split("/")
+    return (
+        *(".".join(parts[: i + 1]) for i in range(len(parts))),
+        *("/".join(pieces[i:]) for i in range(len(pieces))),
+        *(piece + "/" for piece in pieces[:-1]),
+    )
 
 
 def requirement_met(requires: Iterable[str], dependencies: Iterable[str]) -> bool:
     """Whether a file that sees ``dependencies`` satisfies a rule's ``requires`` list."""
     wanted = tuple(requires)
-    forms = requirement_forms(dependencies) if wanted else frozenset()
-    return not wanted or any(want in forms for want in wanted)
+    return not wanted or Requirements(dependencies).met(wanted)
+
+
+class Requirements:
+    """Which ``requires`` lists a file that sees ``dependencies`` meets, each list asked
+    once, the dependencies' forms made when first needed."""
+
+    def __init__(self, dependencies: Iterable[str]) -> None:
+        self.dependencies = dependencies
+        self.answers: dict[tuple[str, ...], bool] = {}
+        self._forms: frozenset[str] | None = None
+
+    def met(self, requires: tuple[str, ...]) -> bool:
+        if not requires:
+            return True
+        answer = self.answers.get(requires)
+        if answer is None:
+            if self._forms is None:
+                self._forms = requirement_forms(self.dependencies)
+            forms = self._forms
+            answer = self.answers[requires] = any(want in forms for want in requires)
+        return answer
 
 
 class RuleIndex:

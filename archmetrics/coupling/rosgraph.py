@@ -90,9 +90,21 @@ def _starts(
 ) -> dict[str, list[Launched]]:
     """For each element, the launch entries that start it."""
     found: dict[str, list[Launched]] = {}
+    if not tree.launched:
+        return found
+    members: dict[str, list[Element]] = {}  # package folder -> its elements
+    for element in elements:
+        for folder in {tree.package_of(path) for path in element.files} - {None}:
+            members.setdefault(str(folder), []).append(element)
+    registered: dict[str, set[str]] = {}  # a receiving plugin key -> the elements holding it
+    for name, own in sites.items():
+        for site in own:
+            if site.role is Role.RECEIVE and site.endpoint and _type(site) == "plugin":
+                registered.setdefault(site.endpoint.key, set()).add(name)
     for entry in tree.launched:
-        for element in launched_elements(entry, tree, sites, elements, element_of):
-            found.setdefault(element, []).append(entry)
+        chosen = launched_elements(entry, tree, sites, members, registered, element_of)
+        for started in chosen:
+            found.setdefault(started, []).append(entry)
     return found
 
 
@@ -100,25 +112,19 @@ def launched_elements(
     entry: Launched,
     tree: RosTree,
     sites: Mapping[str, tuple[LinkSite, ...]],
-    elements: Sequence[Element],
+    members: Mapping[str, list[Element]],
+    registered: Mapping[str, set[str]],
     element_of: Mapping[str, str],
 ) -> set[str]:
     """The elements a launch entry starts: a component's, the elements holding its
-    registration; an executable's, among the elements of its package (when the tree holds
-    it), those its ``console_scripts`` entry names, else those whose node has its name, else
-    those with a file of its name (``talker`` -> ``src/talker.cpp``)."""
+    registration; an executable's, among the elements of its package (``members``, by
+    package folder, when the tree holds it), those its ``console_scripts`` entry names, else
+    those whose node has its name, else those with a file of its name (``talker`` ->
+    ``src/talker.cpp``)."""
     if entry.plugin:
-        kind = tree.aliases.get(entry.plugin, entry.plugin)
-        key = f"plugin:{kind}"
-        return {
-            element for element, found in sites.items()
-            for s in found if s.role is Role.RECEIVE and s.endpoint and s.endpoint.key == key
-        }  # fmt: skip
+        return set(registered.get(f"plugin:{tree.aliases.get(entry.plugin, entry.plugin)}", ()))
     folders = tree.package_folders(entry.package) if entry.package else []
-    inside = [
-        e for e in elements
-        if any(tree.package_of(path) in folders for path in e.files)
-    ]  # fmt: skip
+    inside = [e for folder in folders for e in members.get(folder, ())]
     for folder in folders:
         script = tree.executables.get((folder, entry.executable))
         if script is not None and script in element_of:

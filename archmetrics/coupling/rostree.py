@@ -39,6 +39,7 @@ class RosTree:
     aliases: dict[str, str] = field(default_factory=dict)  # plugin lookup name -> class
     descriptions: dict[str, set[str]] = field(default_factory=dict)  # class -> files naming it
     executables: dict[tuple[str, str], str] = field(default_factory=dict)  # (folder, exe) -> file
+    _by_parameter: dict[str, list[Setting]] | None = None
 
     def package_folders(self, name: str) -> list[str]:
         """The folders holding the package called ``name``."""
@@ -46,27 +47,32 @@ class RosTree:
 
     def package_of(self, path: str) -> str | None:
         """The folder of the package ``path`` is in (the deepest holding a package.xml)."""
-        folder = PurePosixPath(path).parent
+        folder = path.rpartition("/")[0]
         while True:
-            text = "" if str(folder) == "." else str(folder)
-            if text in self.packages:
-                return text
-            if not text:
+            if folder in self.packages:
+                return folder
+            if not folder:
                 return None
-            folder = folder.parent
+            folder = folder.rpartition("/")[0]
 
-    def values_for(self, node: str, parameter: str) -> set[str]:
-        """The values the parameter files give ``parameter`` of the node ``node``
-        (``/ns/name``), by its fully qualified name, its name, or ``/**``."""
+    def _setting(self, node: str, parameter: str) -> list[Setting]:
+        """The settings of ``parameter`` for the node ``node`` (``/ns/name``): by its fully
+        qualified name, its name, or ``/**``."""
+        if self._by_parameter is None:
+            self._by_parameter = {}
+            for setting in self.settings:
+                self._by_parameter.setdefault(setting.parameter, []).append(setting)
         name = node.rsplit("/", 1)[-1]
         keys = {node, node.lstrip("/"), name, "/" + name, "/**", "**"}
-        return {s.value for s in self.settings if s.parameter == parameter and s.node in keys}
+        return [s for s in self._by_parameter.get(parameter, ()) if s.node in keys]
+
+    def values_for(self, node: str, parameter: str) -> set[str]:
+        """The values the parameter files give ``parameter`` of the node ``node``."""
+        return {s.value for s in self._setting(node, parameter)}
 
     def setters(self, node: str, parameter: str) -> set[str]:
         """The parameter files that set ``parameter`` for ``node``."""
-        name = node.rsplit("/", 1)[-1]
-        keys = {node, node.lstrip("/"), name, "/" + name, "/**", "**"}
-        return {s.path for s in self.settings if s.parameter == parameter and s.node in keys}
+        return {s.path for s in self._setting(node, parameter)}
 
 
 def read_tree(by_path: Mapping[str, FileFacts]) -> RosTree:
@@ -86,11 +92,7 @@ def read_tree(by_path: Mapping[str, FileFacts]) -> RosTree:
 def _xml(tree: RosTree, path: str, facts: FileFacts) -> None:
     for table in facts.tables:
         if table.keys == ("package", "name") and (name := table.get(TEXT)):
-            tree.packages[
-                str(PurePosixPath(path).parent).replace(".", "", 1)
-                if PurePosixPath(path).parent == PurePosixPath(".")
-                else str(PurePosixPath(path).parent)
-            ] = name[0]
+            tree.packages[path.rpartition("/")[0]] = name[0]
         elif table.keys[-1:] == ("class",) and table.keys[0] in ("library", "class_libraries"):
             kind = (table.get("type") or table.get("name") or ("",))[0]
             lookup = (table.get("name") or table.get("type") or ("",))[0]

@@ -16,7 +16,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from archmetrics.coupling.matching import constructed, matches, normalize_callee, requirement_met
+from archmetrics.coupling.matching import (
+    Requirements,
+    constructed,
+    matches,
+    normalize_callee,
+)
 from archmetrics.coupling.rosnames import NodeName, clean_namespace
 from archmetrics.coupling.rules import Place, ScopeRule
 from archmetrics.coupling.trace import ArgumentReader, member
@@ -54,7 +59,8 @@ def receiver_of(call: CallSite) -> str | None:
 
 
 class FileScopes:
-    """The node and handle scopes of one file, and which applies to a call."""
+    """The node and handle scopes of one file, and which applies to a call (found when a
+    call first asks: most files' sites need none)."""
 
     def __init__(
         self,
@@ -63,23 +69,31 @@ class FileScopes:
         visible: Sequence[str],
         read: ArgumentReader,
     ) -> None:
-        usable = [
-            r for r in rules
-            if facts.language in r.languages and requirement_met(r.requires, visible)
-        ]  # fmt: skip
-        self.scopes: list[Scope] = []
+        self.facts, self.rules, self.visible, self.read = facts, rules, visible, read
+        self._scopes: list[Scope] | None = None
+
+    @property
+    def scopes(self) -> list[Scope]:
+        if self._scopes is None:
+            self._scopes = self._find()
+        return self._scopes
+
+    def _find(self) -> list[Scope]:
+        language = self.facts.language
+        seen = Requirements(self.visible)
+        usable = [r for r in self.rules if language in r.languages and seen.met(r.requires)]
         if not usable:
-            return
-        names = {p.rsplit(".", 1)[-1] for r in usable for p in r.match}
-        for call in facts.call_sites:
+            return []
+        names = {normalize_callee(p).rsplit(".", 1)[-1] for r in usable for p in r.match}
+        found = []
+        for call in self.facts.call_sites:
             callee, _ = constructed(call)
-            if normalize_callee(callee).rsplit(".", 1)[-1] not in names and not any(
-                "*" in n for n in names
-            ):
+            if normalize_callee(callee).rsplit(".", 1)[-1] not in names:
                 continue
             rule = next((r for r in usable if any(matches(p, callee) for p in r.match)), None)
             if rule is not None:
-                self.scopes.append(_scope(call, rule, read))
+                found.append(_scope(call, rule, self.read))
+        return found
 
     def context(self, call: CallSite) -> tuple[NodeName, str | None]:
         """The node a call's names resolve in (its name None when not known), and the

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Sequence
+from functools import lru_cache
 
 from archmetrics.coupling.matching import matches
 from archmetrics.coupling.rules import Place, ValueRule
@@ -37,43 +38,85 @@ def pick(arguments: Sequence[Argument], place: Place) -> Argument | None:
     return None
 
 
+class _ValueIndex:
+    """Value rules by the last name their patterns match (as matching.RuleIndex does for
+    link rules), a callee's rule asked once."""
+
+    def __init__(self, rules: tuple[ValueRule, ...]) -> None:
+        self.rules = rules
+        self.names: set[str] = set()
+        self.wild = False
+        for rule in rules:
+            for pattern in rule.match:
+                last = pattern.rsplit(".", 1)[-1]
+                self.wild = self.wild or any(c in last for c in "*?[")
+                self.names.add(last)
+        self.found: dict[str, ValueRule | None] = {}
+
+    def rule_of(self, callee: str, name: str) -> ValueRule | None:
+        if not self.wild and name not in self.names:
+            return None
+        if callee not in self.found:
+            self.found[callee] = next(
+                (r for r in self.rules if any(matches(p, callee) for p in r.match)), None
+            )
+        return self.found[callee]
+
+
+@lru_cache(maxsize=64)
+def _index(rules: tuple[ValueRule, ...]) -> _ValueIndex:
+    return _ValueIndex(rules)
+
+
 class ValueCalls:
     """A file's calls that the ``[[values]]`` rules know, indexed by what they give a value
     to: the name their value is assigned to (``target``), the argument they write
-    (``out``), the parameter they declare with a default."""
+    (``out``), the parameter they declare with a default. The index is made when first
+    asked (most files' endpoints are literals and never ask)."""
 
     def __init__(self, facts: FileFacts, rules: Sequence[ValueRule]) -> None:
-        self.rules = [r for r in rules if facts.language in r.languages]
-        self.assigned: dict[str, list[tuple[CallSite, ValueRule]]] = {}
-        self.defaults: dict[str, list[tuple[CallSite, ValueRule]]] = {}
-        if not self.rules:
-            return
-        wanted = {p.rsplit(".", 1)[-1] for r in self.rules for p in r.match}
-        for call in facts.call_sites:
-            if call.name not in wanted and not any("*" in w for w in wanted):
-                continue
-            rule = self.rule_of(call.callee)
-            if rule is None:
-                continue
-            if call.target is not None:
-                self.assigned.setdefault(member(call.target), []).append((call, rule))
-            if rule.out is not None:
-                written = [a for a in call.arguments if a.keyword is None]
-                if rule.out < len(written):
-                    self.assigned.setdefault(member(written[rule.out].text), []).append(
-                        (call, rule)
-                    )
-            if rule.value is not None and rule.name is not None:
-                named = pick(call.arguments, rule.name)
-                if named is not None and isinstance(named.value, str):
-                    self.defaults.setdefault(named.value, []).append((call, rule))
+        self.facts = facts
+        self.index = _index(tuple(r for r in rules if facts.language in r.languages))
+        self._assigned: dict[str, list[tuple[CallSite, ValueRule]]] | None = None
+        self._defaults: dict[str, list[tuple[CallSite, ValueRule]]] = {}
+
+    @property
+    def rules(self) -> tuple[ValueRule, ...]:
+        return self.index.rules
+
+    @property
+    def assigned(self) -> dict[str, list[tuple[CallSite, ValueRule]]]:
+        if self._assigned is None:
+            self._assigned = {}
+            if self.index.rules:
+                for call in self.facts.call_sites:
+                    rule = self.index.rule_of(call.callee, call.name)
+                    if rule is not None:
+                        self._add(call, rule)
+        return self._assigned
+
+    @property
+    def defaults(self) -> dict[str, list[tuple[CallSite, ValueRule]]]:
+        _ = self.assigned  # made together
+        return self._defaults
+
+    def _add(self, call: CallSite, rule: ValueRule) -> None:
+        assigned = self._assigned
+        assert assigned is not None
+        if call.target is not None:
+            assigned.setdefault(member(call.target), []).append((call, rule))
+        if rule.out is not None:
+            written = [a for a in call.arguments if a.keyword is None]
+            if rule.out < len(written):
+                assigned.setdefault(member(written[rule.out].text), []).append((call, rule))
+        if rule.value is not None and rule.name is not None:
+            named = pick(call.arguments, rule.name)
+            if named is not None and isinstance(named.value, str):
+                self._defaults.setdefault(named.value, []).append((call, rule))
 
     def rule_of(self, callee: str) -> ValueRule | None:
         """The first value rule whose ``match`` names ``callee``."""
-        for rule in self.rules:
-            if any(matches(pattern, callee) for pattern in rule.match):
-                return rule
-        return None
+        return self.index.rule_of(callee, callee.replace("->", ".").rsplit(".", 1)[-1])
 
     def giving(self, name: str) -> Iterable[tuple[CallSite, ValueRule]]:
         """The calls that give the variable or member ``name`` its value."""

@@ -27,7 +27,12 @@ from archmetrics.parsers import c_tables
 from archmetrics.parsers.c_family_bindings import bindings
 from archmetrics.parsers.c_family_branches import ALL, Conditionals, Group
 from archmetrics.parsers.c_family_calls import CallSites
-from archmetrics.parsers.c_family_constructs import call_targets, constructions, field_types
+from archmetrics.parsers.c_family_constructs import (
+    call_targets,
+    constructions,
+    field_types,
+    initialized_members,
+)
 from archmetrics.parsers.c_family_definitions import Definition, definitions
 from archmetrics.parsers.c_family_grammar import (
     QUERY_DEPTH,
@@ -552,7 +557,8 @@ def _facts(
     )
     _decisions(found, owner, reading.directive_decisions)
     constructs = in_order(found.get("construct", []))
-    members = field_types(found.get("field", []), data) if constructs else {}
+    wanted = initialized_members(constructs, data) if constructs else set()
+    members = field_types(found.get("field", []), data, wanted) if wanted else {}
     targets = call_targets(
         [*found.get("bind", []), *(n for n in constructs if n.type == "field_initializer")], data
     )

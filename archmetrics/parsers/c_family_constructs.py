@@ -85,26 +85,35 @@ def _values(value: Node | None) -> list[Node]:
     return found
 
 
-def _assignment(node: Node, data: bytes) -> tuple[str | None, Node | None]:
+_VALUES = frozenset(
+    {"call_expression", "new_expression", "field_expression", "parenthesized_expression"}
+)
+
+
+def _assignment(node: Node) -> tuple[Node | None, Node | None]:
+    """(target, value) of an assignment, initialized declarator or member initializer whose
+    value may be a call; Nones for any other (most assign literals or names: no text read)."""
     kind = node.type
     if kind == "init_declarator":
         value = node.child_by_field_name("value")
-        if value is None or value.type in _ARGUMENTS:
+        if value is None or value.type not in _VALUES:
             return None, None
-        name = _declared(node.child_by_field_name("declarator"))
-        return (None if name is None else _short(name, data)), value
+        return _declared(node.child_by_field_name("declarator")), value
     if kind == "assignment_expression":
-        operator = node.child_by_field_name("operator")
-        left = node.child_by_field_name("left")
-        if operator is None or operator.type != "=" or left is None:
+        right = node.child_by_field_name("right")
+        if right is None or right.type not in _VALUES:
             return None, None
-        return _short(left, data), node.child_by_field_name("right")
+        operator = node.child_by_field_name("operator")
+        if operator is None or operator.type != "=":
+            return None, None
+        return node.child_by_field_name("left"), right
     if kind == "field_initializer":
         name = node.named_child(0)
         arguments = node.named_child(node.named_child_count - 1) if name is not None else None
         if name is None or arguments is None or arguments.named_child_count != 1:
             return None, None
-        return _short(name, data), arguments.named_child(0)
+        value = arguments.named_child(0)
+        return (name, value) if value is not None and value.type in _VALUES else (None, None)
     return None, None
 
 
@@ -113,30 +122,42 @@ def call_targets(nodes: Iterable[Node], data: bytes) -> dict[tuple[int, int], st
     a constructor's member initializer keeps: its byte range -> the target as written."""
     targets: dict[tuple[int, int], str] = {}
     for node in nodes:
-        name, value = _assignment(node, data)
-        if name is None:
+        target, value = _assignment(node)
+        if target is None:
             continue
-        for call in _values(value):
-            targets[(call.start_byte, call.end_byte)] = name
+        calls = _values(value)
+        if calls and (name := _short(target, data)) is not None:
+            for call in calls:
+                targets[(call.start_byte, call.end_byte)] = name
     return targets
 
 
-def field_types(nodes: Iterable[Node], data: bytes) -> dict[str, str]:
-    """The declared type of each member a file declares by a plain name (``Foo x_;``, not a
-    pointer or a reference), for names declared with one type only."""
+def field_types(nodes: Iterable[Node], data: bytes, wanted: set[str]) -> dict[str, str]:
+    """The declared type of each member among ``wanted`` a file declares by a plain name
+    (``Foo x_;``, not a pointer or a reference), for names declared with one type only."""
     types: dict[str, str | None] = {}
     for node in nodes:
-        kind = node.child_by_field_name("type")
-        if kind is None:
-            continue
-        written = _short(kind, data)
         for index in range(node.named_child_count):
             declarator = node.named_child(index)
             if declarator is None or declarator.type != "field_identifier":
                 continue
             name = text(declarator, data).decode("utf-8", "replace")
+            if name not in wanted:
+                continue
+            kind = node.child_by_field_name("type")
+            written = _short(kind, data) if kind is not None else None
             types[name] = written if types.get(name, written) == written else None
     return {name: kind for name, kind in types.items() if kind}
+
+
+def initialized_members(nodes: Iterable[Node], data: bytes) -> set[str]:
+    """The names of the members constructors' initializers name (``as_`` of ``as_(...)``)."""
+    found = set()
+    for node in nodes:
+        name = node.named_child(0) if node.type == "field_initializer" else None
+        if name is not None and name.type == "field_identifier":
+            found.add(text(name, data).decode("utf-8", "replace"))
+    return found
 
 
 def constructions(

@@ -13,7 +13,7 @@ its parent element's table. Nothing is executed or resolved: ``$(find pkg)`` sta
 
 from __future__ import annotations
 
-from lxml import etree
+from typing import TYPE_CHECKING
 
 from archmetrics.facts import ConfigFormat, ConfigTable, FileFacts
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, not_measured
@@ -24,8 +24,13 @@ holds tens; a larger XML file is data, not hand-written configuration)."""
 
 TEXT = "#text"  # the key an element's text is kept under
 
+if TYPE_CHECKING:
+    from lxml import etree
+
 
 def _parser() -> etree.XMLParser:
+    from lxml import etree  # imported when an XML file is read (coupling only reads TEXT)
+
     return etree.XMLParser(
         resolve_entities=False,
         no_network=True,
@@ -44,6 +49,8 @@ def _local(tag: str) -> str:
 
 def parse(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
     """The elements of an XML document, each with its line; never raises for bad input."""
+    from lxml import etree
+
     language = ConfigFormat.XML.value
     try:
         root = etree.fromstring(source.encode("utf-8", "surrogatepass"), _parser())
