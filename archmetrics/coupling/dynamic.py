@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, replace
 
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.graphnames import (
+    TypeAliases,
     completed,
     data_type,
     graph_endpoint,
@@ -65,10 +66,12 @@ class AmbiguousEndpoint(Exception):
 @dataclass(frozen=True, slots=True)
 class FileContext:
     """What resolving a file's graph names needs: its naming scopes and, in Python, the names
-    its imports bind (a type written ``Twist`` is ``geometry_msgs.msg.Twist``)."""
+    its imports bind (a type written ``Twist`` is ``geometry_msgs.msg.Twist``), in C and C++
+    its type aliases."""
 
     scopes: FileScopes
     imports: Mapping[str, str] = field(default_factory=dict)
+    aliases: TypeAliases | None = None  # C++: the file's type aliases
 
 
 def _pick(arguments: Sequence[Argument], index: int | None, keyword: str | None) -> Argument | None:
@@ -248,7 +251,7 @@ def _call_site(
                    note=note)  # fmt: skip
     if spec is None or context is None or not (spec.naming or spec.value or spec.data_type):
         return site
-    kind = data_type(call, spec.data_type, context.imports, spec.naming == "ros1")
+    kind = data_type(call, spec.data_type, context.imports, spec.naming == "ros1", context.aliases)
     if spec.created_by and endpoint is None:
         return replace(site, data_type=kind)  # its maker gives it (receivers.py)
     parameter = endpoint.via.partition(":")[2] if endpoint and endpoint.via.startswith(

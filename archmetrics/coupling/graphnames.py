@@ -7,22 +7,33 @@ it is resolved against the node and handle the call is made in (scopes.py):
 parameter. A name that cannot be resolved statically (a private name in a node whose name is
 computed) leaves the site without an endpoint, its note saying why, its name kept. The data
 type is read as written and spelled as ROS's tools spell it (``geometry_msgs/msg/Twist``);
-in Python a type imported by name is read through its import.
+in Python a type imported by name is read through its import, in C++ a type alias of the
+same file (``using Msg = std_msgs::msg::String;``, ``using std_msgs::msg::Int32;``) through
+the alias.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.matching import constructed
 from archmetrics.coupling.model import Endpoint, LinkSite
-from archmetrics.coupling.rosnames import NodeName, UnresolvedName, interface_type, resolve
+from archmetrics.coupling.rosnames import (
+    UNKNOWN,
+    NodeName,
+    UnresolvedName,
+    interface_type,
+    resolve,
+)
 from archmetrics.coupling.rules import EndpointSpec, Place
 from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.values import pick
-from archmetrics.facts import CallSite, Dependency
+from archmetrics.facts import Binding, CallSite, Dependency
+
+_TYPE_NAME = re.compile(r"[A-Za-z_]\w*(?:::[A-Za-z_]\w*)*(?:<.*>)?")
 
 
 def imported_names(dependencies: Sequence[Dependency]) -> dict[str, str]:
@@ -51,13 +62,44 @@ def qualified(callee: str, imports: Mapping[str, str]) -> str:
     return f"{found}{dot}{rest}" if found else callee
 
 
+class TypeAliases:
+    """A C++ file's type aliases, read from its bindings when first asked: each name with
+    the types it is given, in the function that gives it (None: at file, namespace or class
+    level). Only a binding whose value is a plain (qualified) name is an alias."""
+
+    __slots__ = ("_bindings", "_found")
+
+    def __init__(self, bindings: Sequence[Binding]) -> None:
+        self._bindings = bindings
+        self._found: dict[str, dict[str | None, str]] | None = None
+
+    def get(self, name: str, function: str | None) -> str | None:
+        """The type ``name`` stands for in ``function``: its alias there, else one given
+        outside any function; None when there is none."""
+        if self._found is None:
+            found: dict[str, dict[str | None, str]] = {}
+            for binding in self._bindings:
+                value = binding.value.replace(" ", "")
+                if _TYPE_NAME.fullmatch(value) and value != binding.name:
+                    found.setdefault(binding.name, {})[binding.function] = value
+            self._found = found
+        given = self._found.get(name)
+        if given is None:
+            return None
+        return given.get(function) or given.get(None)
+
+
 def data_type(
-    call: CallSite, place: Place | None, imports: Mapping[str, str], ros1: bool = False
+    call: CallSite,
+    place: Place | None,
+    imports: Mapping[str, str],
+    ros1: bool = False,
+    aliases: TypeAliases | None = None,
 ) -> str:
     """The data type a call names at ``place`` (a template argument or an argument), as ROS
-    spells it (ROS 1: ``std_msgs/String``, also for Python's ``std_msgs.msg.String``); ""
-    when it names none."""
-    found = _data_type(call, place, imports)
+    spells it (ROS 1: ``std_msgs/String``, also for Python's ``std_msgs.msg.String``), read
+    through ``aliases`` (C++); "" when it names none."""
+    found = _data_type(call, place, imports, aliases)
     if ros1:
         package, _, rest = found.partition("/")
         kind, _, name = rest.partition("/")
@@ -66,7 +108,9 @@ def data_type(
     return found
 
 
-def _data_type(call: CallSite, place: Place | None, imports: Mapping[str, str]) -> str:
+def _data_type(
+    call: CallSite, place: Place | None, imports: Mapping[str, str], aliases: TypeAliases | None
+) -> str:
     if place is None:
         return ""
     if place.value is not None:
@@ -80,9 +124,15 @@ def _data_type(call: CallSite, place: Place | None, imports: Mapping[str, str]) 
         written = argument.text if argument is not None else None
     if not written:
         return ""
-    head, dot, rest = written.replace(" ", "").partition(".")
+    written = written.replace(" ", "")
+    head, dot, rest = written.partition(".")
     if head in imports:
         written = imports[head] + dot + rest
+    elif aliases is not None:
+        seen = {written}
+        while (given := aliases.get(written, call.function)) and given not in seen:
+            seen.add(given)  # using A = B; using B = pkg::msg::C;
+            written = given
     return interface_type(written)
 
 
@@ -129,7 +179,7 @@ def graph_endpoint(
 def folded(name: str, handle: str | None) -> str:
     """``name`` as it reads without the ROS 1 NodeHandle it was given to (``scan`` on a
     handle made with ``"~"`` is ``~/scan``), so that it resolves alike later (rosgraph.py)."""
-    if handle is None or not handle.strip() or name.startswith(("/", "~")):
+    if handle is None or not handle.strip() or handle == UNKNOWN or name.startswith(("/", "~")):
         return name
     return f"{handle.rstrip('/')}/{name}"
 

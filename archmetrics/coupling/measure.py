@@ -12,7 +12,7 @@ from archmetrics.coupling.config_links import with_config_sites
 from archmetrics.coupling.dynamic import FileContext, LinkFilter, file_link_sites, resolve
 from archmetrics.coupling.elements import Element, element_of_file, group_elements
 from archmetrics.coupling.endpoints import Lookup, Value, constants_of
-from archmetrics.coupling.graphnames import imported_names
+from archmetrics.coupling.graphnames import TypeAliases, imported_names
 from archmetrics.coupling.model import (
     CouplingOptions,
     CouplingReport,
@@ -217,7 +217,8 @@ class Sites:
         if self.rules.scopes or self.rules.values:
             scopes = FileScopes(facts, self.rules.scopes, seen_, tracer.read)
             imports = imported_names(facts.dependencies) if python else {}
-            context = FileContext(scopes, imports)
+            aliases = TypeAliases(facts.bindings) if facts.language in _C_FAMILY else None
+            context = FileContext(scopes, imports, aliases)
         return file_link_sites(facts, self.rules, seen_, tracer.read, modules, context)
 
 

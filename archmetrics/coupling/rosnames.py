@@ -50,6 +50,9 @@ def clean_namespace(text: str | None) -> str:
     return join("/", text or "")
 
 
+UNKNOWN = "\x00"  # a ROS 1 NodeHandle's namespace that is computed at run time
+
+
 def resolve(name: str, node: NodeName, handle: str | None = None) -> str:
     """The absolute name ``name`` stands for in ``node``. ``handle``: the namespace of the
     ROS 1 NodeHandle the name is given to, as written (``~`` private, ``foo`` relative,
@@ -68,15 +71,24 @@ def resolve(name: str, node: NodeName, handle: str | None = None) -> str:
     if text.startswith("/"):
         return join("/", text)
     base = node.namespace
+    if handle == UNKNOWN:
+        raise UnresolvedName(f"{text!r} is given to a NodeHandle whose namespace is computed")
     if handle is not None and handle.strip():
         base = resolve(handle, node)
     return join(base, text)
 
 
+_ADAPTER = re.compile(r"(?:rclcpp::)?(?:TypeAdapter<.*,|adapt_type<.*>::as<)([\w:]+)>")
+
+
 def interface_type(written: str) -> str:
     """A message, service or action type as ROS's tools write it: ``pkg/msg/Name``
-    (``geometry_msgs::msg::Twist``, ``geometry_msgs.msg.Twist``, ``std_msgs::String``)."""
+    (``geometry_msgs::msg::Twist``, ``geometry_msgs.msg.Twist``, ``std_msgs::String``); a
+    type adapter by the ROS type it adapts to."""
     text = _TYPE_NOISE.sub("", written.strip()).lstrip(":")
+    adapted = _ADAPTER.fullmatch(text)  # rclcpp::TypeAdapter<std::string, pkg::msg::T>
+    if adapted:
+        text = adapted.group(1)
     text = re.sub(r"<.*>$", "", text)
     text = text.replace("::", "/").replace(".", "/")
     return text

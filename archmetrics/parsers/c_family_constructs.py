@@ -16,6 +16,7 @@ from collections.abc import Iterable
 
 from tree_sitter import Node
 
+from archmetrics.parsers.c_family_calls import Construction  # where, class, arguments, target
 from archmetrics.parsers.c_family_names import text
 from archmetrics.parsers.c_family_text import compact
 
@@ -160,12 +161,36 @@ def initialized_members(nodes: Iterable[Node], data: bytes) -> set[str]:
     return found
 
 
+def _vexing(declarator: Node, made: Node, data: bytes) -> Construction | None:
+    """``tf2_ros::TransformListener listener(buffer);`` in a function body, which the grammar
+    reads as declaring a function ``listener`` taking a ``buffer`` (C++'s "most vexing
+    parse"): a construction when the type is a class and each parameter is one plain name,
+    as no local function declaration is written."""
+    name = declarator.child_by_field_name("declarator")
+    parameters = declarator.child_by_field_name("parameters")
+    if name is None or name.type != "identifier" or parameters is None:
+        return None
+    if made.type not in ("type_identifier", "qualified_identifier", "template_type"):
+        return None
+    named = [child for child in parameters.named_children if child.type != "comment"]
+    if not named or any(
+        child.type != "parameter_declaration"
+        or child.named_child_count != 1
+        or (child.named_child(0) or child).type != "type_identifier"
+        for child in named
+    ):
+        return None
+    written = _short(made, data)
+    return (declarator, written, parameters, _short(name, data)) if written else None
+
+
 def constructions(
     node: Node, data: bytes, members: dict[str, str], targets: dict[tuple[int, int], str]
-) -> list[tuple[Node, str, Node, str | None]]:
+) -> list[Construction]:
     """The constructor calls ``node`` makes: (where, class, arguments, target) for a
     ``new`` expression, each declarator of a declaration initialized by ``(...)`` or
-    ``{...}``, a constructor's initializer of a base or a member."""
+    ``{...}`` (or read as a function declaration: :func:`_vexing`), a constructor's
+    initializer of a base or a member."""
     kind = node.type
     if kind == "new_expression":
         made = node.child_by_field_name("type")
@@ -176,11 +201,15 @@ def constructions(
     if kind == "declaration":
         made = node.child_by_field_name("type")
         written = _short(made, data) if made is not None else None
-        if written is None:
+        if made is None or written is None:
             return []
         found = []
         for index in range(node.named_child_count):
             declarator = node.named_child(index)
+            if declarator is not None and declarator.type == "function_declarator":
+                if (vexing := _vexing(declarator, made, data)) is not None:
+                    found.append(vexing)
+                continue
             if declarator is None or declarator.type != "init_declarator":
                 continue
             value = declarator.child_by_field_name("value")

@@ -235,14 +235,17 @@ def test_a_parameter_file_sets_the_name_and_receives_the_code_reading_it() -> No
     talker = "talker_pkg/src/talker.cpp"
     declare = site_at(report, talker, 7)
     assert (declare.endpoint.key, declare.targets) == (
-        "parameter:/talker/topic", ("talker_pkg/config/talker_params.yaml",)
+        "parameter:/talker/topic",
+        ("talker_pkg/config/talker_params.yaml",),
     )
     # the file sets topic: news, so the publisher publishes on /news, not the default
     assert site_at(report, talker, 8).endpoint.key == "topic:/news"
     assert site_at(report, talker, 11).endpoint.key == "topic:/news"
     params = report.of_file("talker_pkg/config/talker_params.yaml")
     assert (params.d_a, params.d_e, params.element.files) == (
-        1, 0, ("talker_pkg/config/talker_params.yaml",)
+        1,
+        0,
+        ("talker_pkg/config/talker_params.yaml",),
     )
 
 
@@ -336,6 +339,40 @@ def test_one_topic_with_two_types_is_noted_on_each_site() -> None:
     clash = "/count carries several types: std_msgs/msg/Int32, std_msgs/msg/String"
     assert subscription.note == clash
     assert site_at(report, "a/pub.cpp", 9).note == subscription.note
+
+
+ALIASES = """\
+#include <rclcpp/rclcpp.hpp>
+using std_msgs::msg::Int32;
+typedef example_interfaces::srv::AddTwoInts Sum;
+class Counter : public rclcpp::Node {
+  using Twist = geometry_msgs::msg::Twist;
+  using Vel = Twist;
+  using Text = rclcpp::TypeAdapter<std::string, std_msgs::msg::String>;
+ public:
+  Counter() : Node("counter") {
+    using Twist = geometry_msgs::msg::TwistStamped;
+    a_ = create_publisher<Int32>("count", 1);
+    b_ = create_publisher<Twist>("cmd_vel", 1);
+    c_ = create_service<Sum>("sum", cb);
+    d_ = create_publisher<Text>("text", 1);
+    e_ = create_publisher<Pose>("pose", 1);
+  }
+  void more() { f_ = create_publisher<Vel>("vel", 1); }
+};
+"""
+
+
+def test_cpp_types_are_read_through_the_files_aliases() -> None:
+    report = ros({"a/package.xml": "<package><name>a</name></package>\n", "a/c.cpp": ALIASES})
+    assert [(line, kind) for line, _, _, kind, _ in sites(report, "a/c.cpp")] == [
+        (11, "std_msgs/msg/Int32"),  # using std_msgs::msg::Int32;
+        (12, "geometry_msgs/msg/TwistStamped"),  # the function's own alias first
+        (13, "example_interfaces/srv/AddTwoInts"),  # typedef
+        (14, "std_msgs/msg/String"),  # a type adapter: the ROS type it adapts to
+        (15, "Pose"),  # no alias: as written
+        (17, "geometry_msgs/msg/Twist"),  # an alias of an alias
+    ]
 
 
 ROS1 = """\

@@ -58,6 +58,25 @@ def test_cpp_members_references_and_brace_initializers() -> None:
     ]
 
 
+def test_cpp_type_aliases_bind_their_names_to_the_types() -> None:
+    source = """
+    using Msg = std_msgs::msg::String;
+    using std_msgs::msg::Int32;
+    using namespace std;
+    using namespace a::b;
+    typedef a::B C;
+    typedef void (*F)(int);
+    void g() { using T = q::R<int>; }
+    """
+    assert _bound(source, "cpp") == [
+        ("Msg", "std_msgs :: msg :: String", 2, None),
+        ("Int32", "std_msgs :: msg :: Int32", 3, None),
+        ("C", "a :: B", 6, None),  # a typedef of one plain name; F binds nothing
+        ("T", "q :: R < int >", 8, "g"),
+    ]
+    assert _bound("typedef struct s s_t;\n", "c") == []  # C has no type aliases here
+
+
 def test_c_parameters_are_named_through_their_declarators() -> None:
     source = """
     int listen_on(const char *port, int n, void (*cb)(int), char buf[], ...) { return 0; }

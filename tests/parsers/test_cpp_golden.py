@@ -327,6 +327,26 @@ def test_constructor_calls_without_a_call_expression_are_call_sites() -> None:
     assert {k.function for k in cpp(source).call_sites} == {"Talker::Talker"}
 
 
+def test_a_construction_read_as_a_function_declaration_is_a_call_site() -> None:
+    source = """
+    void f(int);
+    int main() {
+      tf2_ros::TransformListener listener(buffer);
+      ros::NodeHandle child(nh, ns);
+      int g(int);
+      std::string h(std::string);
+    }
+    """
+    calls = [
+        (k.callee, k.span.start, k.target, [a.text for a in k.arguments])
+        for k in cpp(source).call_sites
+    ]
+    assert calls == [
+        ("tf2_ros::TransformListener", 4, "listener", ["buffer"]),
+        ("ros::NodeHandle", 5, "child", ["nh", "ns"]),
+    ]  # the declarations at file scope, of a primitive type or a qualified parameter stay
+
+
 def test_a_macro_called_alone_between_declarations_is_a_call_site() -> None:
     source = """
     #include "pluginlib/class_list_macros.hpp"
