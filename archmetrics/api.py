@@ -1,4 +1,5 @@
-"""archmetrics for notebooks: scans, diffs, series, comparisons and estimates as DataFrames.
+"""archmetrics for notebooks: scans, diffs, series, comparisons, estimates and histories as
+DataFrames.
 
 Each function measures as the command of the same name does (the repository's configuration,
 the facts cache, the parser processes) and returns one row per function, file, element,
@@ -21,6 +22,7 @@ from typing import TYPE_CHECKING
 from archmetrics.app.collect import open_cache
 from archmetrics.app.diff import DiffRequest, run_diff
 from archmetrics.app.estimate import EstimateRequest, run_estimate
+from archmetrics.app.history import HistoryRequest, run_history
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, run_compare, run_series
 from archmetrics.app.settings import settings_for
@@ -31,6 +33,7 @@ from archmetrics.reports.frames import (
     accuracy_table,
     diff_table,
     estimate_table,
+    history_table,
     scan_table,
     trend_table,
 )
@@ -38,11 +41,12 @@ from archmetrics.reports.model import CompareReport
 from archmetrics.sources import EMPTY
 from archmetrics.sources.cache import FactsCache, choose_path
 from archmetrics.sources.checkout import open_checkout
+from archmetrics.sources.githistory import Range
 
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["compare", "diff", "estimate", "scan", "series"]
+__all__ = ["compare", "diff", "estimate", "history", "scan", "series"]
 
 
 def scan(
@@ -158,8 +162,54 @@ def estimate(
     return _frame(estimate_table(report) if actual is None else accuracy_table(report))
 
 
+def history(
+    repo: str | Path = ".",
+    revisions: str = "HEAD",
+    *,
+    first_parent: bool = True,
+    merges: bool = False,
+    since: str | None = None,
+    until: str | None = None,
+    max_count: int | None = None,
+    new: Sequence[str] = (),
+    framework: Sequence[str] = (),
+    exclude: Sequence[str] = (),
+    scheduler: str | None = None,
+    workers: int | None = None,
+    jobs: int = 0,
+) -> pd.DataFrame:
+    """Every commit of ``revisions`` (a range as git log takes it) against its first parent,
+    as ``archmetrics history``: a row per commit and location, with its date (ISO 8601, UTC)
+    and subject, the trend fields, Γ_A, Γ_R, Γ_M and Vg after it. Steps are kept in the
+    facts cache (a history always uses one: a temporary one when the configuration turns
+    it off); ``scheduler`` or ``workers`` run it on a Dask cluster."""
+    from tempfile import TemporaryDirectory
+
+    request = HistoryRequest(
+        _diff_request(Path(repo), new, framework, exclude, jobs),
+        Range(revisions, first_parent, merges, since, until, max_count),
+        scheduler,
+        workers,
+    )
+    settings = request.diff.settings
+    with _cache(settings, True) as facts:
+        if facts is not None:
+            report = run_history(request, cache=facts)
+        else:
+            with TemporaryDirectory() as folder, open_cache(Path(folder) / "f", settings) as own:
+                report = run_history(request, cache=own)
+    return _frame(history_table(report))
+
+
 def _frame(table: Table) -> pd.DataFrame:
-    import pandas as pd  # 0.3 s to import: only when a frame is asked for
+    try:
+        import pandas as pd  # 0.3 s to import: only when a frame is asked for
+    except ModuleNotFoundError as error:
+        raise ModuleNotFoundError(
+            "archmetrics.api returns pandas DataFrames, and pandas is not installed:"
+            " pip install 'archmetrics[api]'",
+            name="pandas",
+        ) from error
 
     return pd.DataFrame.from_records(table.rows, columns=list(table.columns))
 

@@ -9,7 +9,8 @@ from __future__ import annotations
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
@@ -127,6 +128,8 @@ class Settings:
     jobs: int = 0  # 0: one worker per core
     limits: LimitSettings = field(default_factory=LimitSettings)
     macros: MacroSettings = field(default_factory=MacroSettings)
+    gate_lines: tuple[int, ...] = ()  # the line of ``source`` each of ``gates`` is written on
+    notices: tuple[str, ...] = ()  # what the reader should know of how this was read
 
 
 def _strings(value: Any, where: str) -> tuple[str, ...]:
@@ -256,10 +259,16 @@ MAX_CONFIG_BYTES = 1 << 20
 def _read_toml(path: Path) -> dict[str, Any]:
     """The TOML document at ``path``; ConfigError for anything that is not one, however odd
     (a huge file, nesting deep enough to exhaust the parser's recursion, a bad encoding)."""
+    return _read_document(path)[0]
+
+
+def _read_document(path: Path) -> tuple[dict[str, Any], str]:
+    """The TOML document at ``path`` and its text (:func:`_read_toml`)."""
     try:
         if path.stat().st_size > MAX_CONFIG_BYTES:
             raise ConfigError(f"{path}: larger than {MAX_CONFIG_BYTES} bytes; not read")
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        return tomllib.loads(text), text
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
         raise ConfigError(f"{path}: not valid TOML: {error}") from error
     except RecursionError:
@@ -269,20 +278,55 @@ def _read_toml(path: Path) -> dict[str, Any]:
 
 
 def load_settings(root: Path) -> Settings:
-    """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``."""
+    """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``.
+
+    What the reader should know comes as ``notices``: both files configure archmetrics (the
+    first is read, the other ignored), or pyproject.toml has a ``[tool.NAME]`` table whose
+    name is close to ``archmetrics`` (a typo that would otherwise be silently ignored)."""
+    found: list[tuple[Path, Mapping[str, Any], str]] = []
+    notices: list[str] = []
     for name in CONFIG_FILES:
         path = root / name
         if not path.is_file():
             continue
-        document = _read_toml(path)
+        document, text = _read_document(path)
         tool = document.get("tool", {})
         if not isinstance(tool, dict):
             raise ConfigError(f"{path}: tool: expected a table")
         if name == "pyproject.toml":
+            notices += _near_misses(tool, path)
             table = tool.get("archmetrics")
             if table is None:
                 continue
         else:
             table = tool.get("archmetrics", document)
-        return parse_settings(_table(table, f"{path}: tool.archmetrics"), str(path))
-    return Settings()
+        found.append((path, _table(table, f"{path}: tool.archmetrics"), text))
+    if not found:
+        return Settings(notices=tuple(notices))
+    path, table, text = found[0]
+    if len(found) > 1:
+        notices.append(
+            f"{path} and [tool.archmetrics] in {found[1][0]} both configure archmetrics: "
+            f"{path.name} is read, pyproject.toml's table is ignored"
+        )
+    settings = parse_settings(table, str(path))
+    lines = tuple(_line_of(text, gate) for gate in settings.gates)
+    return replace(settings, gate_lines=lines, notices=tuple(notices))
+
+
+def _near_misses(tool: Mapping[str, Any], path: Path) -> list[str]:
+    """A notice for each ``[tool.NAME]`` whose NAME is close to ``archmetrics`` but not it."""
+    names = [name for name in tool if name != "archmetrics" and isinstance(name, str)]
+    close = [n for n in names if get_close_matches("archmetrics", [n.lower()], cutoff=0.8)]
+    return [
+        f"{path}: [tool.{name}] is not read by archmetrics: did you mean [tool.archmetrics]?"
+        for name in close
+    ]
+
+
+def _line_of(text: str, value: str) -> int:
+    """The first line of ``text`` holding ``value`` as written (1 when none does)."""
+    for number, line in enumerate(text.splitlines(), start=1):
+        if value in line:
+            return number
+    return 1

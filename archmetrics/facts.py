@@ -86,10 +86,17 @@ class Function(NamedTuple):
     decisions: tuple[Decision, ...]
     statements: int  # logical statements inside it, its signature included
     parameters: tuple[str, ...] = ()
+    # the fields a reviewer's `archmetrics: ignore[vg]` comment exempts it from ("*": all);
+    # it changes no number, only which thresholds and gates the function can fail
+    suppressed: tuple[str, ...] = ()
 
     @property
     def complexity(self) -> int:
         return 1 + len(self.decisions)
+
+    def exempt(self, field: str) -> bool:
+        """Whether a suppression comment exempts this function from gates on ``field``."""
+        return field in self.suppressed or "*" in self.suppressed
 
 
 class Class(NamedTuple):

@@ -82,7 +82,7 @@ def scanned_files(bench: Bench, name: str) -> int:
 
 def scan_cfamily(bench: Bench, tree: Tree) -> list[report.Result]:
     """archmetrics scan (default jobs) against single-threaded lizard on the C/C++ files, the
-    goal issue 14 sets (>= 3x); then, for reference, against lizard -t N with as many
+    goal in docs/performance.md (>= 3x); then, for reference, against lizard -t N with as many
     threads as archmetrics has workers (lizard's threads share one interpreter's lock)."""
     ours = bench.repeat("scan-c.archmetrics", bench.scan(tree.path, bench.jobs))
     lizard = bench.tool("lizard")
@@ -155,7 +155,7 @@ def diff_rows(
         rows.insert(
             0, report.Row("diff two releases, cold", None, cold, theirs, "cloc --diff", 2.0)
         )
-    rows.append(report.MemoryRow("peak memory, diff cold", cold, 400.0))  # issue 14's goals
+    rows.append(report.MemoryRow("peak memory, diff cold", cold, 400.0))
     return rows
 
 
@@ -163,7 +163,7 @@ EDITED = "numpy/_core/src/multiarray/ctors.c"  # if the head has it; else its la
 
 
 def edit_rows(bench: Bench, history: Path, tag: str) -> list[report.Result]:
-    """issue 14: ``diff --base HEAD --head WORKTREE`` with a warm cache, each run after a new
+    """``diff --base HEAD --head WORKTREE`` with a warm cache, each run after a new
     edit of one C file (a function appended), against ``scan`` of that file (its facts
     cached by the diff); goal: the diff at most 3x the scan (a speed-up of at least 1/3)."""
     clone = bench.work / "edit"
@@ -208,7 +208,7 @@ def copies_repository(bench: Bench, tree: Path, copies: int) -> Path:
 
 
 def edit_growth_rows(bench: Bench, tree: Path) -> list[report.Result]:
-    """issue 14: the warm edit diff of ``edit_rows`` in a repository of ten copies of the
+    """The warm edit diff of ``edit_rows`` in a repository of ten copies of the
     head tree against the same in a repository of one copy; goal: at most 1.5x."""
     summaries = []
     for copies in (1, 10):

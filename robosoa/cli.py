@@ -14,6 +14,7 @@ from typing import Any
 from robosoa import commands, logs
 from robosoa.cli_input import UsageError
 from robosoa.errors import RobosoaError
+from robosoa.extras import missing
 from robosoa.location import Limits
 from robosoa.wire import MAX_DEPTH, MAX_MESSAGE
 
@@ -70,6 +71,9 @@ def _server_commands(sub: Any) -> None:
     p.add_argument("--ttl", type=float, default=3.0, help="default entry TTL in seconds")
     p.add_argument("--federate", action="append", metavar="ENDPOINT",
                    help="also answer for services of this location service (repeatable)")
+    p.add_argument("--accept-federate", action="store_true",
+                   help="let clients add federation peers (anyone who can reach this "
+                   "service; refused with CURVE)")
     _location_limits(p)
     _curve(p)
     p.set_defaults(run=commands.cmd_location)
@@ -169,6 +173,12 @@ def _guard(run: Callable[[], int]) -> int:
     """Run a command; user-facing failures become one line on stderr and an exit status."""
     try:
         return run()
+    except ModuleNotFoundError as exc:  # pyzmq or lxml: the runtime extra
+        said = missing(exc, "this command")
+        if said is None:
+            raise
+        print(f"robosoa: error: {said}", file=sys.stderr)
+        return 2
     except UsageError as exc:
         print(f"robosoa: error: {exc}", file=sys.stderr)
         return 2

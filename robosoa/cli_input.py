@@ -87,4 +87,4 @@ def location_config(args: argparse.Namespace) -> LocationConfig:
     return LocationConfig(args.bind, args.announce or "", args.ttl,
                           tuple(args.federate or ()), args.max_message,
                           args.max_depth, limits, args.curve_secret or "",
-                          args.curve_allow or "")
+                          args.curve_allow or "", args.accept_federate)

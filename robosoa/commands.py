@@ -16,6 +16,7 @@ from robosoa import connect
 from robosoa.bus import Bus
 from robosoa.cli_input import UsageError, endpoint, location_config, parse_pairs, positive
 from robosoa.errors import RobosoaError
+from robosoa.extras import missing
 from robosoa.location import BUS_ENTRY, ServiceInfo
 
 DEFAULT_LOCATION = "zmq://tcp://127.0.0.1:5555"
@@ -286,6 +287,10 @@ def run_gen(words: list[str]) -> int:
     (imported lazily: the bus tools work without it)."""
     try:
         codegen = import_module("robosoa.codegen.cli")
+    except ModuleNotFoundError as exc:  # lxml: the runtime extra
+        raise missing(exc, "code generation") or RobosoaError(
+            f"code generation is not available: {exc}"
+        ) from None
     except ImportError as exc:
         raise RobosoaError(f"code generation is not available: {exc}") from None
     run: Callable[[list[str]], int | None] = codegen.main

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 from robosoa.versions import version_key, version_matcher
@@ -70,11 +70,13 @@ class ServiceInfo:
     key: str = ""  # zmq with CURVE: the public key (z85) of the endpoint's server socket
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-compatible form."""
-        data = asdict(self)
-        data["operations"] = list(self.operations)
-        data["idempotent"] = list(self.idempotent)
-        return data
+        """JSON-compatible form (built field by field: ``dataclasses.asdict`` deep-copies
+        and took 0.18 ms per entry, most of a federated listing's time)."""
+        return {"name": self.name, "version": self.version,
+                "operations": list(self.operations), "pattern": self.pattern,
+                "endpoint": self.endpoint, "instance": self.instance, "group": self.group,
+                "host": self.host, "pid": self.pid, "ttl": self.ttl, "origin": self.origin,
+                "idempotent": list(self.idempotent), "key": self.key}
 
     @staticmethod
     def from_dict(data: Mapping[str, Any]) -> ServiceInfo:

@@ -150,8 +150,9 @@ class LocationService:
 
     def __init__(self, registry: Registry, peer_factory: PeerFactory | None = None,
                  hello: Mapping[str, Any] | None = None, name: str = "location",
-                 limits: Limits = Limits()) -> None:
+                 limits: Limits = Limits(), refuse_federate: str = "") -> None:
         self.registry = registry
+        self.refuse_federate = refuse_federate  # why a client's federate is refused; "": not
         self.name = name
         self.limits = limits
         self.counter = Counter("requests", "location")  # count; errors: refused requests
@@ -171,19 +172,28 @@ class LocationService:
             self._peers[address] = self._peer_factory(address)
             log.info("federated", extra={"peer": address})
 
+    def needs_peers(self, request: Mapping[str, Any]) -> bool:
+        """Whether answering ``request`` means asking federated peers (and so waiting up to
+        ``federation_timeout``): a lookup, not local, of a name not known here or of all."""
+        if request.get("op") != "lookup" or request.get("local") or not self._peers:
+            return False
+        name = request.get("name")
+        return name is None or not select(self.registry.entries(), str(name), None)
+
     def lookup(self, name: str | None, local: bool = False) -> list[ServiceInfo]:
         """Local entries; peers are asked only for names not known locally (and for listings),
         all at once and for ``federation_timeout`` seconds in total; a peer that failed or
-        did not answer in time is skipped for ``PEER_BACKOFF`` seconds."""
+        did not answer in time is dropped from this answer, counted, and skipped for
+        ``PEER_BACKOFF`` seconds. A peer's entries of other names are ignored."""
         found = select(self.registry.entries(), name, None)
         if local or (found and name is not None):
             return found
         seen = {info.instance for info in found}
         for address, remote in self._ask_peers(name):
             for info in remote[: self.limits.max_per_peer]:
-                if info.instance not in seen:
-                    seen.add(info.instance)
-                    found.append(replace(info, origin=info.origin or address))
+                if info.instance not in seen and name in (None, info.name):
+                    seen.add(info.instance)  # a peer's word on keys is never passed on
+                    found.append(replace(info, origin=info.origin or address, key=""))
         return found
 
     def _ask_peers(self, name: str | None) -> list[tuple[str, list[ServiceInfo]]]:
@@ -195,6 +205,7 @@ class LocationService:
         for address, outcome in ask_all(calls, self.limits.federation_timeout).items():
             if isinstance(outcome, Exception):  # a dead peer must not break local lookups
                 self._backoff[address] = self._clock() + PEER_BACKOFF
+                self.counter.drop("late" if isinstance(outcome, TimeoutError) else "bad-reply")
                 log.warning("federated lookup failed", extra={"peer": address,
                                                               "error": str(outcome)})
             else:
@@ -222,6 +233,8 @@ class LocationService:
                                     bool(request.get("local", False)))
                 return {"services": [i.to_dict() for i in infos]}
             if op == "federate":
+                if self.refuse_federate:
+                    return {"error": f"federate refused: {self.refuse_federate}"}
                 self.federate(str(request["address"]))
                 return {"ok": True}
             if op == "hello":

@@ -12,7 +12,7 @@ from typing import Any, NamedTuple
 
 from robosoa import blobs
 from robosoa.errors import InvalidMessage
-from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, load_json
+from robosoa.wire import MAX_DEPTH, MAX_MESSAGE, LimitExceeded, load_json
 
 Payload = dict[str, Any]
 
@@ -234,13 +234,17 @@ def decode(raw: bytes, max_bytes: int = MAX_MESSAGE, max_depth: int = MAX_DEPTH)
 
 
 def decode_frames(frames: Sequence[bytes], max_bytes: int = MAX_MESSAGE,
-                  max_depth: int = MAX_DEPTH) -> Message:
-    """Parse a message of one JSON frame and its binary frames (``robosoa.blobs``)."""
+                  max_depth: int = MAX_DEPTH, max_total: int = 0) -> Message:
+    """Parse a message of one JSON frame and its binary frames (``robosoa.blobs``); each
+    frame at most ``max_bytes``, all of them at most ``max_total`` (0: ``max_bytes``)."""
     if len(frames) == 1:
         return decode(frames[0], max_bytes, max_depth)
     if not frames or len(frames) > blobs.MAX_BLOBS + 1:
         raise InvalidMessage(f"message of {len(frames)} frames (at most "
                              f"{blobs.MAX_BLOBS + 1})")
+    total = max_total or max_bytes
+    if sum(map(len, frames)) > total:
+        raise LimitExceeded(f"message of more than {total} bytes in its frames")
     data = load_json(frames[0], max_bytes, max_depth)
     if type(data) is not dict:
         raise InvalidMessage("message is not a JSON object")

@@ -22,6 +22,13 @@ REASONS = {
     "lifespan": "a message was older than its lifespan",
     "lost": "sequence numbers skipped: dropped in a ZeroMQ queue or a lost connection",
     "blocked": "a reliable publish found no room within its blocking time",
+    "late": "a federated location service did not answer within its time budget (a reply "
+            "over the size cap is dropped unread by ZeroMQ and counts here)",
+    "bad-reply": "a federated location service's reply was malformed",
+    "busy": "every federation worker was busy: a lookup was answered from local entries only",
+    "truncated": "entries left out of a lookup reply to keep it within the frame limit",
+    "budget": "a peer connection was more than its byte budget ahead of the provider (a "
+              "message too large in all its frames): it was shut down, with what it queued",
 }
 
 

@@ -5,8 +5,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 from tests.gitrepo import GitRepo
+
+# No test asserts a time: hypothesis's per-example deadline and its "too slow" health check
+# are clocks, which a loaded machine (CI's two cores, other jobs) trips without a defect.
+settings.register_profile(
+    "archmetrics", deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.load_profile("archmetrics")
 
 
 @pytest.fixture

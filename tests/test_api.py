@@ -132,3 +132,15 @@ def test_an_estimate_frame_has_the_rows_and_columns_of_the_csv(
     _same(errors, _csv(capsys, *argv, "--actual", "--head", "first"))
     total = errors.query("architecture == 'b' and name == 'total' and figure == 'cost'")
     assert total["error"].tolist() == [0.0]  # the sketch is the measured change
+
+
+def test_a_history_frame_has_the_rows_and_columns_of_the_csv(
+    stages: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    frame = api.history(stages.root, new=["new/**"])
+    assert list(frame["subject"].unique()) == ["one", "two", "three"]
+    assert len(frame) == 3 * 4
+    new = frame[frame["location"] == "new"].set_index("subject")
+    assert new.loc["two", "changes"] > 0 and new.loc["one", "changes"] == 0
+    csv = _csv(capsys, "history", "-C", str(stages.root), "--new", "new/**")
+    _same(frame, csv)

@@ -66,3 +66,25 @@ def test_macros_are_read_sorted_without_repeats(tmp_path: Path) -> None:
     settings = load_settings(tmp_path)
     assert settings.macros.attribute == ("B_API", "my_export")
     assert settings.macros.function == ("TEST",)
+
+
+def test_both_configurations_say_which_is_read_and_a_near_miss_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from archmetrics.cli import main
+
+    (tmp_path / "archmetrics.toml").write_text('gates = ["changes > 1"]\n')
+    (tmp_path / "pyproject.toml").write_text(
+        '[tool.archmetrics]\ngates = ["changes > 2"]\n\n[tool.archmetric]\njobs = 1\n'
+    )
+    (tmp_path / "a.py").write_text("x = 1\n")
+    settings = load_settings(tmp_path)
+    assert settings.gates == ("changes > 1",) and settings.gate_lines == (1,)
+    assert main(["scan", str(tmp_path), "-q", "--no-cache", "-v"]) == 0
+    err = capsys.readouterr().err
+    assert (
+        f"warning: {tmp_path / 'archmetrics.toml'} and [tool.archmetrics] in "
+        f"{tmp_path / 'pyproject.toml'} both configure archmetrics: archmetrics.toml is read"
+    ) in err
+    assert "[tool.archmetric] is not read by archmetrics: did you mean [tool.archmetrics]?" in err
+    assert f"archmetrics: configuration: {tmp_path / 'archmetrics.toml'}" in err

@@ -58,6 +58,7 @@ def test_wheel_contents(wheel: Path) -> None:
         "archmetrics/schemas/graph-1.schema.json",
         "archmetrics/schemas/rules-1.schema.json",
         "archmetrics/schemas/study-2.schema.json",
+        "archmetrics/schemas/baseline-1.schema.json",
     ):
         assert required in names, required
     assert not [n for n in names if "__pycache__" in n or n.endswith((".pyc", ".o", ".so"))]

@@ -17,13 +17,17 @@ def _run(*command: str) -> subprocess.CompletedProcess[str]:
 
 
 def test_ruff() -> None:
-    done = _run(str(BIN / "ruff"), "check", "archmetrics", "robosoa", "tests", "benchmarks")
+    done = _run(
+        str(BIN / "ruff"), "check", "archmetrics", "robosoa", "tests", "benchmarks", "action"
+    )
     assert done.returncode == 0, done.stdout + done.stderr
 
 
 def test_mypy_strict() -> None:
     done = _run(str(BIN / "mypy"))
     assert done.returncode == 0, done.stdout + done.stderr
+    action = _run(str(BIN / "mypy"), "--strict", "action/run.py")  # the action's steps
+    assert action.returncode == 0, action.stdout + action.stderr
 
 
 def test_import_layers() -> None:

@@ -19,12 +19,14 @@ from archmetrics.app.coupling import (
     rule_set,
 )
 from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.app.settings import gate_origins
 from archmetrics.app.tree import Side, begin_delta, side_of
+from archmetrics.app.unit_gates import for_gates, split_gates, touched_units
 from archmetrics.app.workers import WorkerLimits
 from archmetrics.changeset import ChangeReport, FilePair, LocationRules, compute_change
 from archmetrics.changeset.elements import Differ
 from archmetrics.changeset.files import exclusion, pair_files
-from archmetrics.changeset.gates import Gate, check_gates, parse_gate
+from archmetrics.changeset.gates import Gate, check_gates
 from archmetrics.changeset.model import MeasuredFile
 from archmetrics.changeset.rows import FileRow, diff_measured
 from archmetrics.changeset.statement_diff import (
@@ -36,6 +38,8 @@ from archmetrics.changeset.statement_diff import (
     same_statements,
 )
 from archmetrics.changeset.unchanged import Unchanged
+from archmetrics.complexity.baseline import Baseline
+from archmetrics.complexity.thresholds import Threshold, check_units
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, group_elements
 from archmetrics.coupling.rules import RuleSet
@@ -66,6 +70,8 @@ class DiffRequest:
     gates: tuple[str, ...] = ()  # --fail-on, after the configured ones
     jobs: int = 0
     dynamic_pre_zero: bool = False
+    base_label: str = ""  # how reports name the base (``A...B``), when not ``base`` itself
+    baseline: Baseline | None = None  # offenders already known (--baseline FILE)
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,7 +80,8 @@ class DiffOptions:
     of a diff (and each stage of a series) reads these, never the two sources again."""
 
     rules: LocationRules
-    gates: tuple[Gate, ...]
+    gates: tuple[Gate, ...]  # on the change's summaries (cost(new) > 20)
+    unit_gates: tuple[Threshold, ...]  # on the functions and files it touches (app/unit_gates)
     languages: tuple[tuple[str, str], ...]  # file ending -> language
     limits: WorkerLimits
     jobs: int
@@ -88,9 +95,11 @@ def diff_options(request: DiffRequest, root: Path) -> DiffOptions:
     from there). A bad gate or rule pack fails here, before any work."""
     settings = request.settings
     limits = worker_limits(settings.limits, settings.macros)
+    gates, unit_gates = split_gates((*settings.gates, *request.gates))
     return DiffOptions(
         rules=location_rules(request),
-        gates=tuple(parse_gate(g) for g in (*settings.gates, *request.gates)),
+        gates=gates,
+        unit_gates=unit_gates,
         languages=settings.languages,
         # generated files count nowhere unless asked for: the first lines that say so suffice
         limits=replace(limits, skip_generated=not settings.include_generated),
@@ -339,12 +348,13 @@ def measure_snapshots(
     else:
         moved = renames() if callable(renames) else renames
     progress.phase("comparing the changed files")
-    change = _compare(pre, post, moved, options, progress, cache)
+    change = compare_sides(pre, post, moved, options, progress, cache)
     progress.stop()
+    change = for_gates(change, pre, post, options.rules, bool(options.unit_gates))
     return change, parse_warnings(pre.state.rows, post.state.rows, rules=options.rules)
 
 
-def _compare(
+def compare_sides(
     pre: Side,
     post: Side,
     renames: Mapping[str, str],
@@ -440,6 +450,14 @@ def run_diff(
     options = options or diff_options(request, checkout.root)  # a bad gate fails before work
     change, warnings = measure_change(request, progress, cache, checkout, options)
     gates = options.gates
-    report = DiffReport(request.base, request.head, change, warnings, tuple(g.text for g in gates))
+    label = request.base_label or request.base
+    texts = (*(g.text for g in gates), *(t.text for t in options.unit_gates))
+    report = DiffReport(label, request.head, change, warnings, texts)
     failures = check_gates(gates, report.summaries())
-    return DiffReport(report.base, report.head, change, warnings, report.gates, failures)
+    checked = check_units(options.unit_gates, touched_units(change), request.baseline)
+    origins = gate_origins(request.settings, checkout.root)
+    commits = (checkout.commit_id(request.base), checkout.commit_id(request.head))
+    return replace(
+        report, failures=failures, offenders=checked.failures, suppressed=checked.suppressed,
+        baselined=checked.baselined, origins=origins, commits=commits,
+    )  # fmt: skip

@@ -22,6 +22,7 @@ from archmetrics.app.diff import (
     site_memo,
 )
 from archmetrics.app.progress import NoProgress, Progress
+from archmetrics.app.settings import gate_origins
 from archmetrics.app.sketch import MeasuredBase, sketched
 from archmetrics.changeset import ChangeReport, FilePair, compute_change, coupling_by_element
 from archmetrics.changeset.accuracy import compare_change
@@ -135,10 +136,11 @@ def _estimate(
         found = sketched(plan, architecture, context)
     stages, failures = [], []
     texts = tuple(g.text for g in gates)
+    origins = gate_origins(context.request.settings, context.checkout.root)
     before = context.request.base  # each stage is estimated on the one before it
     for stage, (change, warnings) in zip(architecture.stages, found, strict=True):
         head = f"{architecture.name}/{stage.label} (estimate)"
-        report = DiffReport(before, head, change, warnings, texts)
+        report = DiffReport(before, head, change, warnings, texts, origins=origins)
         before = head
         failed = check_gates(gates, report.summaries())
         stages.append(Stage(stage.label, replace(report, failures=failed)))
@@ -222,12 +224,21 @@ def run_estimate(
         tuple(estimates),
         tuple(g.text for g in gates),
         tuple(failures),
+        plan_path=_inside(request.plan, checkout.root),
     )
     if request.actual is not None:
         actual = replace(request.diff, head=request.actual)
         report = _with_actual(report, actual, checkout, options, progress, cache)
     progress.stop()
     return report
+
+
+def _inside(path: Path, root: Path) -> str | None:
+    """``path`` relative to the repository's top ``root``, None when it lies outside."""
+    try:
+        return path.resolve().relative_to(root.resolve()).as_posix()
+    except (ValueError, OSError):
+        return None
 
 
 def _with_actual(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
@@ -13,11 +14,12 @@ from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.locations import LocationRules
 from archmetrics.changeset.model import ExcludedFile
 from archmetrics.complexity import file_metrics, totals
+from archmetrics.complexity.baseline import Baseline
 from archmetrics.complexity.thresholds import (
     FIELDS,
     Threshold,
     Unit,
-    check_thresholds,
+    check_units,
     parse_threshold,
 )
 from archmetrics.config import Settings
@@ -42,6 +44,7 @@ class ScanRequest:
     jobs: int = 0
     plain_directory: bool = False  # read the one path given as a folder, even inside git
     gates: tuple[str, ...] = ()  # thresholds to check (--fail-on 'vg(function) > 15')
+    baseline: Baseline | None = None  # offenders already known (--baseline FILE)
 
 
 def _locate(request: ScanRequest) -> tuple[Path, Snapshot, tuple[str, ...]]:
@@ -83,13 +86,19 @@ def _under(path: str, prefixes: tuple[str, ...]) -> bool:
 
 
 def _nothing_to_measure(request: ScanRequest, snapshot: Snapshot, prefixes: tuple[str, ...]) -> str:
+    """Why nothing is measured: a note (a tree of docs only is measured as empty, exit 0, so
+    that a job over the changed files passes a change with no source in it); a path missing
+    at the revision asked for is an error (SourceError, exit 2)."""
     if request.rev is not None and prefixes:
         known = [f.path for f in snapshot.files()]
         missing = [p for p in prefixes if not any(_under(k, (p,)) for k in known)]
         if missing:
-            return f"{missing[0]}: no such path at revision {request.rev}"
+            raise SourceError(f"{missing[0]}: no such path at revision {request.rev}")
     where = ", ".join(prefixes) or "the tree"
-    return f"no source files to measure in {where} ({snapshot.label}); see 'languages' in docs"
+    return (
+        f"no source files to measure in {where} ({snapshot.label}): nothing measured; file"
+        " endings are read as docs/metrics.md says ('languages' in the configuration adds some)"
+    )
 
 
 def run_scan(
@@ -120,8 +129,7 @@ def run_scan(
     judged = [(item, rules.is_excluded(item.file.path)) for item in selected]
     excluded = [ExcludedFile(item.file.path, why) for item, why in judged if why]
     selected = tuple(item for item, why in judged if why is None)
-    if not selected:
-        raise SourceError(_nothing_to_measure(request, snapshot, prefixes))
+    notes = () if selected else (_nothing_to_measure(request, snapshot, prefixes),)
     if isinstance(snapshot, DirectorySnapshot):
         excluded += [ExcludedFile(path, reason) for path, reason in snapshot.skipped.items()]
     jobs = request.jobs or request.settings.jobs
@@ -140,31 +148,45 @@ def run_scan(
         coupling=coupling,
         excluded=tuple(excluded),
         gates=tuple(t.text for t in thresholds),
+        notes=notes,
     )
     if not thresholds:
         return report
-    failures = check_thresholds(thresholds, _units(report, thresholds))
-    return dataclasses.replace(report, failures=failures)
+    checked = check_units(thresholds, units_of(report, thresholds), request.baseline)
+    return dataclasses.replace(
+        report,
+        failures=checked.failures,
+        suppressed=checked.suppressed,
+        baselined=checked.baselined,
+    )
 
 
-def _units(report: ScanReport, thresholds: tuple[Threshold, ...]) -> dict[str, list[Unit]]:
+def units_of(report: ScanReport, thresholds: Iterable[Threshold]) -> dict[str, list[Unit]]:
     """The functions, files, elements and the total of ``report`` as threshold units (only
     the kinds some threshold names), their numbers read from the rows the CSV and the API
-    show (reports/frames.py)."""
+    show (reports/frames.py); a function's with its suppression comment's fields."""
     units: dict[str, list[Unit]] = {}
     for kind in {t.unit for t in thresholds}:
+        if kind == "function":
+            units[kind] = [
+                Unit(fn.qualified_name, f.path, fn.line, {"vg": fn.vg, "loc": fn.loc},
+                     suppressed=fn.suppressed)
+                for f in report.files
+                for fn in f.functions
+            ]
+            continue
         if kind == "total":
             numbers = totals_dict(report.totals)
             units[kind] = [Unit("total", None, None, {f: numbers[f] for f in FIELDS[kind]})]
             continue
         table = scan_table(report, kind)
         rows = [dict(zip(table.columns, row, strict=True)) for row in table.rows]
-        name, path, line = _WHERE[kind]
+        name, path = _WHERE[kind]
         units[kind] = [
             Unit(
                 str(row[name]),
                 str(row[path]) if path else None,
-                int(row[line]) if line else None,  # type: ignore[arg-type]
+                None,
                 {f: int(row[f]) for f in FIELDS[kind]},  # type: ignore[arg-type]
             )
             for row in rows
@@ -172,9 +194,5 @@ def _units(report: ScanReport, thresholds: tuple[Threshold, ...]) -> dict[str, l
     return units
 
 
-# a unit kind's columns (reports/frames.py) naming it, its file and its line
-_WHERE = {
-    "function": ("function", "path", "line"),
-    "file": ("path", "path", None),
-    "element": ("element", None, None),
-}
+# a unit kind's columns (reports/frames.py) naming it and its file
+_WHERE = {"file": ("path", "path"), "element": ("element", None)}

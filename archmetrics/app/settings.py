@@ -7,6 +7,7 @@ import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
+from archmetrics.changeset.gates import GateOrigin
 from archmetrics.config import Settings, load_settings
 from archmetrics.globs import compile_glob
 
@@ -34,3 +35,21 @@ def settings_at(root: Path, exclude: Sequence[str] = ()) -> Settings:
     if not exclude:
         return settings
     return dataclasses.replace(settings, exclude=settings.exclude + tuple(exclude))
+
+
+def gate_origins(settings: Settings, root: Path) -> tuple[GateOrigin, ...]:
+    """Where each configured gate is written: the configuration file, relative to ``root``
+    (the repository's top), and the gate's line. None when the settings were not read from
+    a file inside ``root``."""
+    source = Path(settings.source)
+    if not source.is_file():
+        return ()
+    try:
+        path = source.resolve().relative_to(root.resolve()).as_posix()
+    except ValueError:
+        return ()
+    lines = settings.gate_lines or (1,) * len(settings.gates)
+    return tuple(
+        GateOrigin(gate.strip(), path, line)
+        for gate, line in zip(settings.gates, lines, strict=True)
+    )

@@ -164,7 +164,9 @@ def side_of(
         except CodecError:
             pass  # not believed: built again below, and kept over it
     # without a cache, both sides are built whole: --no-cache measures from scratch
-    side = _patched(snapshot, origin, options, cache, progress, delta) if origin and cache else None
+    side = None
+    if origin and cache:
+        side = patched_side(snapshot, origin, options, cache, progress, delta)
     side = side or whole_side(snapshot, options, cache, progress)
     if key is not None and cache is not None:
         cache.put_total(key, encode(side.state))
@@ -201,7 +203,7 @@ def _couple(
     return build_index(links, [f.path for f in measured])
 
 
-def _patched(
+def patched_side(
     snapshot: Snapshot,
     origin: Side,
     options: DiffOptions,

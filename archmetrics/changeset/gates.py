@@ -20,8 +20,17 @@ from archmetrics.complexity.thresholds import COMPARISON, OPERATORS, or_of_ands
 _CONDITION = re.compile(
     r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*" + COMPARISON
 )
-NUMERIC_FIELDS = tuple(f for f in SUMMARY_FIELDS if f != "notes")
+NUMERIC_FIELDS = (*(f for f in SUMMARY_FIELDS if f != "notes"), "unparsed")
 LOCATIONS = ("base", "new", "framework", "total")
+
+
+_UNIT = re.compile(r"\(\s*(?:function|file)\s*\)")
+
+
+def is_unit_gate(text: str) -> bool:
+    """Whether ``text`` gates the functions or files a change touches (``vg(function) >
+    15``, a threshold: complexity/thresholds.py) rather than a location's summary."""
+    return _UNIT.search(text) is not None
 
 
 class GateError(ValueError):
@@ -96,6 +105,22 @@ class GateFailure:
     def __str__(self) -> str:
         read = ", ".join(f"{name} = {value:g}" for name, value in self.values)
         return f"gate failed: {self.gate.text} ({read})"
+
+
+@dataclass(frozen=True, slots=True)
+class GateOrigin:
+    """Where a gate is written: a configuration file (relative to the repository's top) and
+    the line that holds the gate's text. A gate given on the command line has none."""
+
+    gate: str
+    path: str
+    line: int
+
+
+def measured_values(gate: Gate, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
+    """Every condition's value on these summaries, by ``FIELD(LOCATION)`` (None: undefined),
+    whether the gate failed or not: what the JSON's gate entries carry."""
+    return {c.name: c.value(summaries) for group in gate.groups for c in group}
 
 
 def check_gates(gates: Iterable[Gate], summaries: Mapping[str, Summary]) -> tuple[GateFailure, ...]:

@@ -71,6 +71,17 @@ class LocationRules:
                 return rule.location
         return Location.BASE
 
+    def unmatched(self, paths: Iterable[str]) -> tuple[str, ...]:
+        """The location and exclude globs that match none of ``paths`` (a typo, or quotes
+        kept around a glob): each is named in a warning, never silently ignored."""
+        left = dict.fromkeys((*(r.pattern for r in self.rules), *self.exclude))
+        for path in paths:
+            if not left:
+                break
+            for pattern in [p for p in left if glob_matches(p, path)]:
+                del left[pattern]
+        return tuple(left)
+
     def is_excluded(self, path: str) -> str | None:
         """Why ``path`` is left out of the measurement (``exclude:<glob>``), or None."""
         for pattern in self.exclude:

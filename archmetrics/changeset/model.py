@@ -9,14 +9,15 @@ undefined -- always with a note saying why (docs/metrics.md, "Conventions").
 from __future__ import annotations
 
 import heapq
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from functools import cached_property
 from typing import NamedTuple, Protocol
 
 from archmetrics.changeset.locations import Location
 from archmetrics.changeset.statement_diff import FileChange
+from archmetrics.complexity import FileMetrics, FunctionMetrics
 
 JsonValue = int | float | str | None | list["JsonValue"] | dict[str, "JsonValue"]
 
@@ -180,12 +181,16 @@ class Summary:
     scaled_delta_vg: float
     cost: float
     notes: tuple[str, ...] = ()
+    # files the change touched that could not be parsed after it (a syntax error): dropped
+    # from both sides (listed as excluded, not_parsed), counted here so a gate can fail them
+    unparsed: int = 0
 
     def to_dict(self) -> dict[str, JsonValue]:
         out: dict[str, JsonValue] = {}
         for name in SUMMARY_FIELDS:
             value = getattr(self, name)
             out[name] = list(value) if isinstance(value, tuple) else value
+        out["unparsed"] = self.unparsed
         return out
 
 
@@ -237,6 +242,15 @@ class PlainLike(Protocol):
     def records(self) -> list[dict[str, JsonValue]]: ...
 
 
+class Touched(NamedTuple):
+    """A file the change touched, as it is after the change, and its functions the change
+    touched (a statement added, removed or modified inside them, or the function new):
+    what a diff's function and file gates check (docs/ci.md, "Gates")."""
+
+    file: FileMetrics
+    functions: tuple[FunctionMetrics, ...]
+
+
 def _element_name(change: ElementChange) -> str:
     return change.element
 
@@ -254,6 +268,8 @@ class ChangeReport:
     computed: tuple[ElementChange, ...]  # sorted by element name
     excluded: tuple[ExcludedFile, ...]
     plain: PlainLike | None = None
+    unmatched: tuple[str, ...] = ()  # location and exclude globs that matched no file
+    touched: tuple[Touched, ...] = ()  # the files the change touched, after it
 
     @cached_property
     def elements(self) -> tuple[ElementChange, ...]:
@@ -279,6 +295,16 @@ class ChangeReport:
 
     def __hash__(self) -> int:
         return hash(self._compared())
+
+    def with_unparsed(self, by_location: Mapping[Location, int]) -> ChangeReport:
+        """This report with each location's (and the total's) count of touched files that
+        could not be parsed."""
+        locations = tuple(
+            (loc, replace(summary, unparsed=by_location.get(loc, 0)))
+            for loc, summary in self.locations
+        )
+        total = replace(self.total, unparsed=sum(by_location.values()))
+        return replace(self, locations=locations, total=total)
 
     def location(self, location: Location) -> Summary:
         """The summary S(L) of one location."""

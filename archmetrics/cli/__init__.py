@@ -14,10 +14,11 @@ import traceback
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
+from archmetrics.app.history_dask import ClusterError
 from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
-from archmetrics.cli import docs, estimate, measure, study
+from archmetrics.cli import baseline, docs, estimate, history, measure, study
 from archmetrics.cli.common import EXIT_USAGE, UsageError
 from archmetrics.cli.parser import build_parser, settle_format
 from archmetrics.complexity.thresholds import ThresholdError
@@ -33,9 +34,11 @@ from archmetrics.study.manifest import ManifestError
 
 COMMANDS = {
     "scan": measure.scan_command,
+    "baseline": baseline.baseline_command,
     "diff": measure.diff_command,
     "series": measure.series_command,
     "compare": measure.compare_command,
+    "history": history.history_command,
     "estimate": estimate.estimate_command,
     "replicate": study.replicate_command,
     "rules": measure.rules_command,
@@ -56,6 +59,8 @@ CANNOT_MEASURE = (
     ManifestError,
     CacheError,
     PlanError,
+    baseline.BaselineError,
+    ClusterError,
 )
 
 
@@ -82,8 +87,8 @@ def few_collections() -> Iterator[None]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    settle_format(args)
     try:
+        settle_format(args)
         if getattr(args, "jobs", 0) < 0:
             raise UsageError("--jobs must be 0 or more")
         if (getattr(args, "max_rows", None) or 0) < 0:

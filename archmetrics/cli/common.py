@@ -15,7 +15,7 @@ from archmetrics.app import settings as app_settings
 from archmetrics.app.collect import open_cache
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.gates import GateFailure
-from archmetrics.complexity.thresholds import ThresholdFailure
+from archmetrics.complexity.thresholds import ThresholdFailure, worst_first
 from archmetrics.config import Settings
 from archmetrics.globs import BadPattern
 from archmetrics.reports.formats import OutputFormat
@@ -53,18 +53,38 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
 
 
+def _rate_column() -> Any:
+    """A progress column with how many steps a second are done (files parsed, commits
+    measured), once rich has seen enough to say."""
+    from rich.progress import ProgressColumn, Task
+    from rich.text import Text
+
+    class Rate(ProgressColumn):
+        def render(self, task: Task) -> Text:
+            speed = task.speed
+            return Text(f"{speed:.1f}/s" if speed else "", style="progress.data.speed")
+
+    return Rate()
+
+
 class RichProgress:
     """A rich progress bar on stderr, for runs over many files in a terminal."""
 
     def __init__(self) -> None:
         from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TimeRemainingColumn,
+        )
 
         self._console = Console(stderr=True)
         self._bar = Progress(
             "[progress.description]{task.description}",
             BarColumn(),
             MofNCompleteColumn(),
+            _rate_column(),
             TimeRemainingColumn(),
             console=self._console,
             transient=True,
@@ -140,6 +160,10 @@ def _with_excludes(
     if group is not None:  # --group over [tool.archmetrics.coupling] group
         coupling = dataclasses.replace(settings.coupling, group=group, per_file=group == "file")
         settings = dataclasses.replace(settings, coupling=coupling)
+    for notice in settings.notices:
+        warn(notice)
+    if args is not None:
+        _detail(args, f"configuration: {settings.source}")
     return settings
 
 
@@ -204,15 +228,18 @@ def _detail(args: argparse.Namespace, text: str) -> None:
 
 def gate_status(
     failures: Sequence[GateFailure | ThresholdFailure | EstimateFailure], args: argparse.Namespace
-) -> int:
+) -> int:  # (worst first: the units past their limits furthest)
     """Exit 1 if a gate failed, else 0. Each failure goes to stderr unless the report itself
     showed it on stdout (a table or Markdown, every report lists its failed gates): a
     failure is printed once, and a report written to a file or as data still names it;
     past the first ``SHOWN_FAILURES`` (a threshold thousands of functions fail), a count."""
-    shown = args.output is None and args.format in (OutputFormat.TABLE, OutputFormat.MARKDOWN)
+    on_stdout = (OutputFormat.TABLE, OutputFormat.MARKDOWN, OutputFormat.WARNINGS)
+    shown = args.output is None and args.format in on_stdout
     if not shown:
         more = "... and {count} more failures (the report lists them)"
-        for line in shown_lines(failures, SHOWN_FAILURES, more):
+        units = worst_first(f for f in failures if isinstance(f, ThresholdFailure))
+        ordered = [f for f in failures if not isinstance(f, ThresholdFailure)] + list(units)
+        for line in shown_lines(ordered, SHOWN_FAILURES, more):
             print(f"archmetrics: {one_line(line)}", file=sys.stderr)
     return EXIT_GATE if failures else EXIT_OK
 

@@ -12,6 +12,7 @@ from archmetrics.app.progress import NoProgress
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
 from archmetrics.app.settings import repo_root
+from archmetrics.cli.baseline import load_baseline
 from archmetrics.cli.common import (
     EXIT_OK,
     UsageError,
@@ -23,7 +24,10 @@ from archmetrics.cli.common import (
     settings_for,
     shown_progress,
     split,
+    warn,
 )
+from archmetrics.reports.charts import charts_missing
+from archmetrics.reports.diff_rows import unmatched_glob
 from archmetrics.reports.formats import (
     Grouping,
     OutputFormat,
@@ -34,6 +38,7 @@ from archmetrics.reports.formats import (
 )
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources.checkout import Checkout, open_checkout
+from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import resolve_path
 
 
@@ -46,6 +51,9 @@ def check_chart(args: argparse.Namespace) -> str | None:
     fmt: str = args.chart.suffix.lower().lstrip(".")
     if fmt not in ("png", "svg"):
         raise UsageError(f"{args.chart}: --chart needs a .png or .svg file")
+    missing = charts_missing()
+    if missing is not None:
+        raise UsageError(f"--chart: {missing}")
     folder = args.chart.parent
     if not folder.is_dir():
         raise UsageError(f"{args.chart}: --chart: no folder {folder}")
@@ -96,12 +104,16 @@ def scan_command(args: argparse.Namespace) -> int:
         jobs=args.jobs,
         plain_directory=args.sample,
         gates=tuple(args.fail_on),
+        baseline=load_baseline(args.baseline),
     )
     with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
         report = run_scan(request, progress, cache)
         progress.phase("writing the report")
         text = render_scan(report, fmt, Grouping(args.by))
     emit(text, args.output)
+    if args.output is not None or fmt not in (OutputFormat.TABLE, OutputFormat.MARKDOWN):
+        for note in report.notes:  # (a table or Markdown on stdout shows them)
+            print(f"archmetrics: note: {note}", file=sys.stderr)
     return gate_status(report.failures, args)
 
 
@@ -149,22 +161,66 @@ def graph_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def revisions_to_compare(args: argparse.Namespace) -> tuple[str, str]:
-    """--base and --head, or with --from-pre-commit the range pre-commit was asked to check
-    (``pre-commit run --from-ref A --to-ref B`` sets both variables; a commit sets neither,
-    and the hook's own --base HEAD --head INDEX then measure the staged change)."""
+def revisions_to_compare(args: argparse.Namespace, checkout: Checkout) -> tuple[str, str, str]:
+    """The base and head to compare, and how to name the base: --base and --head; ``--base
+    A...B`` (or --merge-base) compares B with the merge base of A and B, as ``git diff
+    A...B`` does, and ``--base A..B`` is A against B. With --from-pre-commit, the range
+    pre-commit was asked to check (``pre-commit run --from-ref A --to-ref B``, and pre-push,
+    set both variables), compared as pre-commit selects its files: A...B. A commit sets
+    neither: the hook's own --base HEAD --head INDEX measure the staged change."""
+    head_given = args.head is not None
+    base, head, merge = args.base, args.head or "WORKTREE", args.merge_base
     if args.from_pre_commit:
         start = os.environ.get("PRE_COMMIT_FROM_REF", "")
         end = os.environ.get("PRE_COMMIT_TO_REF", "")
-        if start and end:
-            return start, end
         if start or end:
-            raise UsageError("pre-commit set only one of PRE_COMMIT_FROM_REF, PRE_COMMIT_TO_REF")
-    return args.base, args.head
+            if not (start and end):
+                raise UsageError(
+                    "pre-commit set only one of PRE_COMMIT_FROM_REF, PRE_COMMIT_TO_REF"
+                )
+            base, head, merge = start, end, True
+        else:
+            check_hook_files(args.files, checkout)
+    elif args.files:
+        raise UsageError(f"diff takes no PATH ({args.files[0]}); did you mean --base or --head?")
+    if "..." in base or ".." in base:
+        base, head, merge = _range(base, head, head_given)
+    if not merge:
+        return base, head, base
+    label = f"{base}...{head}"
+    return checkout.merge_base(base, head), head, label
+
+
+def _range(text: str, head: str, head_given: bool) -> tuple[str, str, bool]:
+    """``A...B`` or ``A..B`` given as --base: its two ends (an empty end is HEAD, as in
+    git) and whether to compare from their merge base."""
+    merge = "..." in text
+    first, _, second = text.partition("..." if merge else "..")
+    first, second = first or "HEAD", second or "HEAD"
+    if head_given and head != second:
+        raise UsageError(f"--base {text} names the head ({second}); --head {head} disagrees")
+    return first, second, merge
+
+
+def check_hook_files(files: list[str], checkout: Checkout) -> None:
+    """Refuse to pass silently when pre-commit hands the hook files that are not the staged
+    change (``pre-commit run --all-files`` or ``--files``): archmetrics measures a change,
+    and without --from-ref/--to-ref nothing says which."""
+    if not files:
+        return
+    staged = checkout.staged_paths()  # as reports name them: escaped as git escapes them
+    others = [path for path in files if quote_path(path) not in staged]
+    if others:
+        raise UsageError(
+            f"pre-commit ran the hook on files, not on a change ({others[0]} is not staged:"
+            " --all-files or --files); archmetrics measures a change: give pre-commit the"
+            " range, e.g. pre-commit run archmetrics --from-ref origin/main --to-ref HEAD,"
+            " or leave the hook out of this run with SKIP=archmetrics"
+        )
 
 
 def diff_request(
-    args: argparse.Namespace, checkout: Checkout, base: str = "", head: str = ""
+    args: argparse.Namespace, checkout: Checkout, base: str = "", head: str = "", label: str = ""
 ) -> DiffRequest:
     """The command line's diff, in the repository the command opened: flags and settings
     are merged from here on once (``app.diff.diff_options``)."""
@@ -172,12 +228,14 @@ def diff_request(
         root=checkout.root,
         base=base,
         head=head,
+        base_label=label,
         settings=settings_at(checkout.root, args),
         new=tuple(args.new),
         framework=tuple(args.framework),
         gates=tuple(args.fail_on),
         jobs=args.jobs,
         dynamic_pre_zero=args.dynamic_pre_zero,
+        baseline=load_baseline(getattr(args, "baseline", None)),
     )
 
 
@@ -224,16 +282,18 @@ def compare_command(args: argparse.Namespace) -> int:
 def diff_command(args: argparse.Namespace) -> int:
     check_chart(args)
     fmt = OutputFormat(args.format)
-    base, head = revisions_to_compare(args)
     checkout = open_checkout(args.repo)
-    request = diff_request(args, checkout, base, head)
+    base, head, label = revisions_to_compare(args, checkout)
+    request = diff_request(args, checkout, base, head, label)
     settings = request.settings
     with facts_cache(args, settings) as cache, shown_progress(fmt, args.quiet) as progress:
         report = run_diff(request, progress, cache, checkout)
         progress.phase("writing the report")
         text = render_diff(report, fmt, args.max_rows)
     emit(text, args.output)
-    stage = Stage(f"{base}..{head}", report)
+    for glob in report.change.unmatched:
+        warn(unmatched_glob(glob))
+    stage = Stage(f"{label}..{head}", report)
     name = resolve_path(Path(args.repo)).name
     write_chart(args, CompareReport(((name, SeriesReport(str(args.repo), (stage,))),)))
-    return gate_status(report.failures, args)
+    return gate_status(report.failed, args)

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from archmetrics import __version__
-from archmetrics.cli.common import Parser
+from archmetrics.cli.common import Parser, UsageError
 from archmetrics.cli.docs import docs_root
 from archmetrics.reports.charts import chart_kinds
 from archmetrics.reports.formats import Grouping, OutputFormat
@@ -72,13 +72,22 @@ def _add_format(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None
 
 
 def settle_format(args: argparse.Namespace) -> None:
-    """``args.format`` when --format was not given: what the suffix of --output names, if it
-    is one of the command's formats, else the command's default."""
+    """``args.format`` when --format was not given: what the suffix of --output names, or
+    the command's default for a file with no suffix (or no file). A suffix that names none
+    of the command's formats (``report.html``) is a usage error, never a table written
+    under a name that says otherwise."""
     if getattr(args, "format", "") is not None or not hasattr(args, "format_default"):
         return
     output = getattr(args, "output", None)
-    named = SUFFIX_FORMATS.get(output.suffix.lower()) if output is not None else None
-    args.format = named if named in args.format_choices else args.format_default
+    suffix = output.suffix.lower() if output is not None else ""
+    named = SUFFIX_FORMATS.get(suffix)
+    if suffix and named not in args.format_choices:
+        known = ", ".join(s for s, f in SUFFIX_FORMATS.items() if f in args.format_choices)
+        raise UsageError(
+            f"{output}: {suffix} names no format of this command (endings: {known});"
+            f" give --format ({', '.join(args.format_choices)})"
+        )
+    args.format = named or args.format_default
 
 
 def add_chart(parser: argparse.ArgumentParser) -> None:
@@ -87,6 +96,16 @@ def add_chart(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--chart-kind", default="cost", choices=chart_kinds(), help="which chart (default: cost)"
+    )
+
+
+def add_baseline(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--baseline",
+        type=Path,
+        metavar="FILE",
+        help="offenders already known (archmetrics baseline): thresholds and function gates"
+        " fail only on new offenders and on offenders that got worse",
     )
 
 
@@ -119,13 +138,55 @@ def add_locations(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_history(commands: argparse._SubParsersAction[Parser]) -> None:
+    history = commands.add_parser(
+        "history",
+        help="every commit of a branch against its first parent: Γ, ΔVg', E per location,"
+        " the costliest commits and the elements where integration cost accumulates",
+    )
+    history.add_argument(
+        "range", nargs="?", default="HEAD", metavar="REV_RANGE",
+        help="the commits, as git log takes them (default HEAD: its whole history)",
+    )  # fmt: skip
+    history.add_argument(
+        "--first-parent", action=argparse.BooleanOptionalAction, default=True,
+        help="follow only first parents, each merge one integrated branch (default: on)",
+    )  # fmt: skip
+    history.add_argument(
+        "--merges", action="store_true", help="only merge commits, each against its first parent"
+    )
+    history.add_argument("--since", metavar="DATE", help="commits after DATE (as git reads it)")
+    history.add_argument("--until", metavar="DATE", help="commits before DATE")
+    history.add_argument(
+        "--max-count", "-n", type=int, metavar="N", help="only the newest N commits"
+    )
+    history.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
+    history.add_argument(
+        "--top", type=int, default=10, metavar="N",
+        help="how many costliest commits and hotspot elements to show (default 10)",
+    )  # fmt: skip
+    history.add_argument("--element", metavar="NAME", help="also show this element's own trend")
+    history.add_argument(
+        "--scheduler", metavar="ADDRESS",
+        help="run on the Dask cluster whose scheduler is at ADDRESS, e.g. tcp://host:8786"
+        " (needs archmetrics[dask]; docs/history.md)",
+    )  # fmt: skip
+    history.add_argument(
+        "--workers", type=int, metavar="N", help="run on a local Dask cluster of N workers"
+    )
+    add_locations(history)
+    add_chart(history)
+    add_output(history, ["table", "json", "markdown", "csv"])
+
+
 def docs_epilog() -> str:
     """Where the installed pages are, for --help (they ship inside the wheel)."""
     root = docs_root()
     where = f"installed in {root}" if root is not None else "missing from this installation"
     return (
-        f"Docs: {where}: metrics.md (what is counted), json.md (the JSON contract), ci.md"
-        " (CI, pre-commit, code scanning); `archmetrics docs [TOPIC]` lists them or prints one."
+        f"Docs: {where}: glossary.md (what each number means), metrics.md (what is counted),"
+        " json.md (the JSON contract), ci.md (CI, pre-commit, code scanning, choosing gates);"
+        " `archmetrics docs [TOPIC]` lists them or prints one."
     )
 
 
@@ -164,14 +225,48 @@ def build_parser() -> argparse.ArgumentParser:
         " exit 1 when a function, file, element or the total fails it (repeatable)",
     )
     add_output(scan, [f.value for f in OutputFormat])
+    add_baseline(scan)
     add_group(scan)
+    baseline = commands.add_parser(
+        "baseline",
+        help="write the offenders of thresholds to a file, so that scan and diff --baseline"
+        " fail only on new or worsened ones",
+    )
+    baseline.add_argument("paths", nargs="*", type=Path, metavar="PATH", help="files or folders")
+    baseline.add_argument("--rev", help="measure this git revision instead of the files on disk")
+    baseline.add_argument(
+        "--fail-on", action="append", default=[], metavar="EXPR",
+        help="a threshold whose offenders to record, e.g. 'vg(function) > 15' (repeatable;"
+        " default: the configuration's function and file gates)",
+    )  # fmt: skip
+    baseline.add_argument(
+        "--output", "-o", type=Path,
+        help="the baseline file to write (default: archmetrics-baseline.json)",
+    )  # fmt: skip
+    baseline.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    baseline.add_argument("--jobs", "-j", type=int, default=0, help="parser processes")
+    baseline.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
+    baseline.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    add_exclude(baseline)
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
-    diff.add_argument("--base", default="HEAD", help="REV, EMPTY, WORKTREE or INDEX (default HEAD)")
     diff.add_argument(
-        "--head", default="WORKTREE", help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
+        "--base",
+        default="HEAD",
+        help="REV, EMPTY, WORKTREE or INDEX (default HEAD); A...B compares B with the merge"
+        " base of A and B, as git diff A...B does (a pull request's own changes); A..B is A"
+        " against B",
     )
+    diff.add_argument(
+        "--head", default=None, help="REV, EMPTY, WORKTREE or INDEX (default WORKTREE)"
+    )
+    diff.add_argument(
+        "--merge-base",
+        action="store_true",
+        help="compare --head with the merge base of --base and --head (as --base A...B)",
+    )
+    diff.add_argument("files", nargs="*", metavar="FILE", help=argparse.SUPPRESS)
     diff.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
     diff.add_argument(
         "--from-pre-commit",
@@ -184,6 +279,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
     add_group(diff)
+    add_baseline(diff)
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -208,6 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    add_history(commands)
     estimate = commands.add_parser(
         "estimate",
         help="price an integration before doing it: each architecture of a plan (TOML) or"

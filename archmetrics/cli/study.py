@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from archmetrics.cli.common import EXIT_OK, UsageError, facts_cache, shown_progress
 from archmetrics.config import Settings
+from archmetrics.reports.charts import charts_missing
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.study.findings import FINDINGS
 from archmetrics.study.report import StudyReport, VariantResult
@@ -23,6 +24,9 @@ def replicate_command(args: argparse.Namespace) -> int:
     from archmetrics.study.causes import load_causes
     from archmetrics.study.report import render_json, render_markdown
 
+    missing = None if args.no_charts else charts_missing()
+    if missing is not None:  # said before the study runs, not after
+        raise UsageError(f"the study's {missing}; or give --no-charts")
     request = ReplicateRequest(subjects_root(), tuple(args.subject), args.jobs, args.keep_repos)
     shown = shown_progress(OutputFormat.TABLE, args.quiet)
     with facts_cache(args, Settings()) as cache, shown as progress:

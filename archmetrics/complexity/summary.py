@@ -21,6 +21,7 @@ class FunctionMetrics:
     end_line: int
     loc: int
     vg: int
+    suppressed: tuple[str, ...] = ()  # fields a reviewer's comment exempts it from
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,6 +58,7 @@ def file_metrics(facts: FileFacts) -> FileMetrics:
             end_line=f.span.end,
             loc=f.statements,
             vg=f.complexity,
+            suppressed=f.suppressed,
         )
         for f in facts.functions
     )

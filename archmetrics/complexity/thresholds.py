@@ -14,6 +14,7 @@ import operator
 import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple, Protocol
 
 OPERATORS: Mapping[str, Callable[[float, float], bool]] = {
     ">=": operator.ge,
@@ -112,12 +113,18 @@ def _condition(text: str, part: str, example: str) -> tuple[str, Condition]:
 
 @dataclass(frozen=True, slots=True)
 class Unit:
-    """One function, file, element or the total: what names it, where it is, its numbers."""
+    """One function, file, element or the total: what names it, where it is, its numbers,
+    and the fields a reviewer's comment exempts it from (a function's ``suppressed``)."""
 
     name: str
     path: str | None
     line: int | None
     values: Mapping[str, int]
+    suppressed: tuple[str, ...] = ()
+
+    def exempt(self, fields: Iterable[str]) -> bool:
+        """Whether a suppression comment exempts this unit from every one of ``fields``."""
+        return all(f in self.suppressed or "*" in self.suppressed for f in fields)
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,15 +140,85 @@ class ThresholdFailure:
         numbers = ", ".join(f"{f} = {unit.values[f]}" for f in self.threshold.fields)
         return f"gate failed: {self.threshold.text}: {where}{unit.name} ({numbers})"
 
+    @property
+    def excess(self) -> float:
+        """How far past its limit the unit lies: for the first condition of the first group
+        that fails, (value − limit) / |limit| for ``>``/``>=`` and (limit − value) / |limit|
+        for ``<``/``<=`` (|limit| at least 1); 0 for ``==``/``!=``. Worst first sorts by it."""
+        for group in self.threshold.groups:
+            if all(c.holds(self.unit.values) for c in group):
+                first = group[0]
+                return past_limit(first.op, float(self.unit.values[first.field]), first.limit)
+        return 0.0
+
+
+def past_limit(op: str, value: float, limit: float) -> float:
+    """How far ``value`` lies past ``limit`` in the direction ``op`` fails, relative to the
+    limit (at least 1 in magnitude): what orders offenders worst first."""
+    scale = max(abs(limit), 1.0)
+    if op in (">", ">="):
+        return (value - limit) / scale
+    if op in ("<", "<="):
+        return (limit - value) / scale
+    return 0.0
+
+
+def worst_first(failures: Iterable[ThresholdFailure]) -> tuple[ThresholdFailure, ...]:
+    """``failures`` with the furthest past its limit first (:attr:`ThresholdFailure.excess`),
+    ties by file, line and name: what every report lists first, so no cap hides the worst."""
+    return tuple(
+        sorted(
+            failures,
+            key=lambda f: (-f.excess, f.unit.path or "", f.unit.line or 0, f.unit.name),
+        )
+    )
+
+
+class Checked(NamedTuple):
+    """What checking thresholds found: the units that fail, and those that would have
+    failed but a suppression comment exempts or the baseline already knows (listed, never
+    hidden)."""
+
+    failures: tuple[ThresholdFailure, ...] = ()
+    suppressed: tuple[ThresholdFailure, ...] = ()
+    baselined: tuple[ThresholdFailure, ...] = ()
+
+
+class Known(Protocol):
+    """A baseline: which of a threshold's failures it already knows (complexity/baseline.py)."""
+
+    def known(self, failures: Sequence[ThresholdFailure]) -> frozenset[int]: ...
+
+
+def check_units(
+    thresholds: Iterable[Threshold],
+    units: Mapping[str, Sequence[Unit]],
+    baseline: Known | None = None,
+) -> Checked:
+    """:func:`check_thresholds`, then set apart the failures a suppression comment exempts
+    (every field the threshold reads) and, of the rest, those ``baseline`` knows."""
+    failures = check_thresholds(thresholds, units)
+    suppressed = tuple(f for f in failures if f.unit.exempt(f.threshold.fields))
+    left = [f for f in failures if not f.unit.exempt(f.threshold.fields)]
+    known = baseline.known(left) if baseline is not None else frozenset()
+    return Checked(
+        tuple(f for i, f in enumerate(left) if i not in known),
+        suppressed,
+        tuple(f for i, f in enumerate(left) if i in known),
+    )
+
 
 def check_thresholds(
     thresholds: Iterable[Threshold], units: Mapping[str, Sequence[Unit]]
 ) -> tuple[ThresholdFailure, ...]:
-    """Every unit that fails a threshold, threshold by threshold, units in the order given
-    (``units``: the units of each kind)."""
+    """Every unit that fails a threshold, threshold by threshold, each threshold's units
+    worst first (:func:`worst_first`; ``units``: the units of each kind)."""
     return tuple(
-        ThresholdFailure(threshold, unit)
+        failure
         for threshold in thresholds
-        for unit in units.get(threshold.unit, ())
-        if threshold.fails(unit.values)
+        for failure in worst_first(
+            ThresholdFailure(threshold, unit)
+            for unit in units.get(threshold.unit, ())
+            if threshold.fails(unit.values)
+        )
     )

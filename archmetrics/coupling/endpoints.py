@@ -14,6 +14,7 @@ from __future__ import annotations
 import ast
 import re
 from collections.abc import Callable, Mapping, Sequence
+from functools import lru_cache
 
 from archmetrics.facts import Argument, Binding
 
@@ -28,7 +29,26 @@ _LIBRARY_SUFFIX = re.compile(r"(\.so(\.\d+)*|\.dll|\.dylib|\.\d+)+$", re.IGNOREC
 
 
 def literal(text: str) -> Value | None:
-    """The value of a literal written ``text`` (Python or C spelling), or None."""
+    """The value of a literal written ``text`` (Python or C spelling), or None. A plain name
+    (most arguments) is no literal; a short text's answer is kept (texts repeat, and a
+    history reads the same files' arguments at every commit that reaches them)."""
+    if len(text) > _KEPT_LITERAL:
+        return _literal(text)
+    return _kept_literal(text)
+
+
+_KEPT_LITERAL = 200  # characters of a literal whose value is kept
+_CONSTANT_NAMES = frozenset({"True", "False", "None"})
+
+
+@lru_cache(maxsize=65536)
+def _kept_literal(text: str) -> Value | None:
+    if _NAME.match(text) and text not in _CONSTANT_NAMES:
+        return None
+    return _literal(text)
+
+
+def _literal(text: str) -> Value | None:
     text = text.strip()
     first = text[:1]
     if (

@@ -247,6 +247,7 @@ def patch_index(
     key that a redone site has or had."""
     if not changed:
         return index
+    affected = _reaching(index.deps, changed)  # first: the overlay below keeps its table
     resolver = StaticResolver(index.paths, options)
     occurrences = {path: resolver.resolve_file(f) for path, f in changed.items()}
     deps = _Overlay(index.deps, {path: _deps(found) for path, found in occurrences.items()})
@@ -255,7 +256,6 @@ def patch_index(
     def element(path: str) -> Element:
         return names.by_name[names.element_of[path]]
 
-    affected = _reaching(index.deps, changed)
     for path in changed:
         affected.update(element(path).files)
     may_link = LinkFilter(rules)
@@ -276,11 +276,18 @@ def patch_index(
 
 
 class _Overlay(Mapping[str, tuple[Dep, ...]]):
-    """``base`` with the records of some files replaced (a file with none has no entry)."""
+    """``base`` with the records of some files replaced (a file with none has no entry).
+
+    A history patches the index of every commit from its parent's: an overlay of an overlay
+    is first made a plain table, so that a look-up never walks a chain as long as the
+    history; the reverse table (:meth:`sources`) is patched from the base's, not rebuilt."""
 
     def __init__(self, base: Mapping[str, tuple[Dep, ...]],
                  changes: Mapping[str, tuple[Dep, ...]]) -> None:  # fmt: skip
+        if isinstance(base, _Overlay):
+            base = base.flat()
         self.base, self.changes = base, changes
+        self._sources: dict[str, list[str]] | None = None
 
     def __getitem__(self, path: str) -> tuple[Dep, ...]:
         if path in self.changes:
@@ -296,6 +303,40 @@ class _Overlay(Mapping[str, tuple[Dep, ...]]):
 
     def __len__(self) -> int:
         return sum(1 for _ in self)
+
+    def flat(self) -> _Table:
+        table = _Table((path, self[path]) for path in self)
+        table.known_sources = self._sources
+        return table
+
+    def sources(self) -> Mapping[str, Sequence[str]]:
+        """For every file depended on, the files that include or import it."""
+        if self._sources is None:
+            made = {target: list(paths) for target, paths in dependents_of(self.base).items()}
+            for path, records in self.changes.items():
+                for dep in self.base.get(path, ()):
+                    if dep.target_file is not None:
+                        made[dep.target_file].remove(path)
+                for dep in records:
+                    if dep.target_file is not None:
+                        made.setdefault(dep.target_file, []).append(path)
+            self._sources = made
+        return self._sources
+
+
+class _Table(dict[str, tuple[Dep, ...]]):
+    """A plain table of dependency records that remembers its reverse table once known."""
+
+    known_sources: dict[str, list[str]] | None = None
+
+    def sources(self) -> Mapping[str, Sequence[str]]:
+        if self.known_sources is None:
+            self.known_sources = {}
+            for path, records in self.items():
+                for dep in records:
+                    if dep.target_file is not None:
+                        self.known_sources.setdefault(dep.target_file, []).append(path)
+        return self.known_sources
 
 
 class _Occurrences(Mapping[str, Sequence[Reaching]]):

@@ -78,8 +78,13 @@ def _compiled(pattern: str) -> GitIgnoreSpec:
 
 @lru_cache(maxsize=1 << 16)
 def matches(pattern: str, callee: str) -> bool:
-    """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches."""
-    return _compiled(pattern).match_file(normalize_callee(callee))
+    """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches:
+    a pattern without a wild card is the normalized name itself; the answer is kept (a
+    function's calls are tried against each hint of each of its sites)."""
+    name, _ = _normalized(callee)
+    if not any(c in pattern for c in "*?[\\") and not pattern.startswith(("!", "#")):
+        return name == normalize_callee(pattern)
+    return _compiled(pattern).match_file(name)
 
 
 def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
@@ -133,6 +138,9 @@ class Requirements:
         return answer
 
 
+WILD_ANSWERS = 200_000  # names whose wild-card answer a rule index keeps
+
+
 class RuleIndex:
     """Rules indexed by the last name their patterns match, so a call is tried on a few."""
 
@@ -140,6 +148,9 @@ class RuleIndex:
         self.by_name: dict[str, list[tuple[int, Rule, str]]] = {}
         self.wild: list[tuple[int, Rule, str]] = []
         self.chosen: dict[tuple[str, bool], Rule | None] = {}  # callees repeat: ask once
+        # the wild-card patterns' answer per name, kept for the process: within one tree
+        # names seldom repeat, but a history meets the same files' names at every commit
+        self._wild_answers: dict[str, bool] = {}
         for order, rule in enumerate(rules):
             for pattern in rule.match:
                 last = normalize_callee(pattern).rsplit(".", 1)[-1]
@@ -158,10 +169,19 @@ class RuleIndex:
         class). One set look-up a callee, where ``choose`` tries each candidate's pattern."""
         if self._wild is None and not self.by_name:
             return False
-        by_name, wild = self.by_name, self._wild
+        by_name, wild, answers = self.by_name, self._wild, self._wild_answers
         for callee in callees:
             name, last = _normalized(callee)
-            if last in by_name or (wild is not None and wild.match_file(name)) or name in MAKERS:
+            if last in by_name or name in MAKERS:
+                return True
+            if wild is None:
+                continue
+            answer = answers.get(name)
+            if answer is None:
+                if len(answers) >= WILD_ANSWERS:
+                    answers.clear()
+                answer = answers[name] = wild.match_file(name)
+            if answer:
                 return True
         return False
 

@@ -18,10 +18,6 @@ import tokenize
 from bisect import bisect_left, bisect_right
 from itertools import accumulate, chain, compress, count, repeat
 from operator import add, ne
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from archmetrics.parsers.python_shown import Shown
 
 _SKIPPED = frozenset(
     {
@@ -80,7 +76,8 @@ class Tokens:
         self.closing: dict[int, int] = {}
         self.soft_keywords: set[int] = set()  # "match" and "case" where they are keywords
         self.statement_parens: set[int] = set()  # "(" of a statement: `with (a, b):`
-        self.texts: Shown | None = None  # call-site texts, made when first asked for
+        # call-site texts (python_shown.Shown), made and typed there when first asked for
+        self.texts: object = None
         self.base = base
         _read(self, source, first_line)
         self._at_start = dict(zip(self.offsets, count()))

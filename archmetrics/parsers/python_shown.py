@@ -126,7 +126,7 @@ def _opens_call(before: str, token: str) -> bool:
 def texts_of(tokens: Tokens) -> Shown:
     """The call-site texts of ``tokens`` (the ``ast`` reader's stream, or a piece of it)."""
     texts = tokens.texts
-    if texts is None:
+    if not isinstance(texts, Shown):
         texts = tokens.texts = Shown(tokens.text)
     return texts
 

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+import functools
+import sys
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
 
 from archmetrics.facts import ConfigFormat, FileFacts, Language, ParseWarning, Severity
 from archmetrics.parsers import text
 from archmetrics.parsers.limits import DEFAULT_LIMITS, ParseLimits, too_large
+from archmetrics.parsers.suppressions import with_suppressions
 
 ParseFunction = Callable[[str, str], FileFacts]
 """(path, decoded source) -> facts. Decoding and binary checks happen before it is called."""
@@ -110,7 +113,16 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
 )
 
 
-def _plugin_languages() -> Iterable[LanguageSpec]:
+def _plugin_languages() -> tuple[LanguageSpec, ...]:
+    """The languages plugins announce, read once per import path: scanning the installed
+    distributions' entry points costs tens of milliseconds, and a history builds its
+    language table for every commit (a path added later, as a test does, is read then)."""
+    return _plugins_on(tuple(sys.path))
+
+
+@functools.lru_cache(maxsize=8)
+def _plugins_on(path: tuple[str, ...]) -> tuple[LanguageSpec, ...]:
+    found = []
     for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
         spec = entry.load()
         if not isinstance(spec, LanguageSpec):
@@ -118,7 +130,8 @@ def _plugin_languages() -> Iterable[LanguageSpec]:
                 f"entry point {entry.name!r} in group {ENTRY_POINT_GROUP} must be a LanguageSpec,"
                 f" got {type(spec).__name__}"
             )
-        yield spec
+        found.append(spec)
+    return tuple(found)
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,7 +202,7 @@ def parse_source(
             warnings=(ParseWarning(path, 1, "binary file with a source ending; not measured"),),
         )
     source, decode_warning = text.decode(path, data)
-    facts = table.spec(language).read(path, source, limits)
+    facts = with_suppressions(table.spec(language).read(path, source, limits), source)
     extra: list[ParseWarning] = [decode_warning] if decode_warning else []
     generated = facts.generated or text.declares_generated(source)
     if not extra and generated == facts.generated:

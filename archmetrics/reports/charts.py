@@ -98,3 +98,20 @@ def render_all(report: CompareReport, fmt: str = "png", scope: Scope = TOTAL) ->
     """Every kind of chart of the study, keyed by file stem (the kind's name); the summary
     kinds over ``scope``."""
     return {kind: render_compare_chart(report, kind, fmt, scope) for kind in _KINDS}
+
+
+EXTRA = "pip install 'archmetrics[api]'"
+
+
+def charts_missing() -> str | None:
+    """Why no chart can be drawn in this installation (matplotlib, the ``api`` extra, is
+    not installed), or None when charts can be drawn."""
+    from importlib.util import find_spec
+
+    try:
+        found = find_spec("matplotlib")
+    except ValueError:  # a module entry of None: blocked, as good as missing
+        found = None
+    if found is None:
+        return f"charts need matplotlib, which is not installed: {EXTRA}"
+    return None

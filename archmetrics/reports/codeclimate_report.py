@@ -3,8 +3,10 @@
 GitLab reads a JSON array of issues, each with a ``description``, a ``check_name``, a
 ``fingerprint`` (the same finding in the next pipeline has the same one), a ``severity`` and
 a ``location`` (a path relative to the repository and a line). Where each finding is located
-is reports/findings.py's: a diff's gate, which is about the whole change, at the repository
-(``.``, line 1). Nothing failed: an empty array. docs/ci.md shows the GitLab job that uploads
+is reports/findings.py's: a diff's gate, which is about the whole change, at the
+configuration file that sets it or the file the change touched most (the description says
+so); only a finding with no file to show (an empty tree) at the repository (``.``, line 1).
+Nothing failed: an empty array. docs/ci.md shows the GitLab job that uploads
 it.
 """
 
@@ -17,6 +19,7 @@ from archmetrics.reports.findings import (
     Finding,
     compare_findings,
     diff_findings,
+    estimate_findings,
     scan_findings,
 )
 from archmetrics.reports.model import (
@@ -34,7 +37,7 @@ def _issue(finding: Finding) -> dict[str, Any]:
     return {
         "type": "issue",
         "check_name": f"archmetrics {finding.rule}",
-        "description": finding.message,
+        "description": finding.text,
         "categories": ["Complexity"],
         "fingerprint": finding.fingerprint,
         "severity": SEVERITY,
@@ -67,4 +70,4 @@ def render_compare(report: CompareReport) -> str:
 
 def render_estimate(report: EstimateReport) -> str:
     """Every failed gate of every architecture's stage (estimated figures)."""
-    return render_compare(report.compare())
+    return _dump(estimate_findings(report))

@@ -23,7 +23,7 @@ from archmetrics.reports.model import (
 )
 
 
-def _csv(table: Table) -> str:
+def write_csv(table: Table) -> str:
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(table.columns)
@@ -34,13 +34,13 @@ def _csv(table: Table) -> str:
 def render_scan(report: ScanReport, grouping: str) -> str:
     """One row per file, function, element or link (``grouping``); by file, the excluded
     files too (each with its reason in the last column)."""
-    return _csv(scan_table(report, grouping, excluded=True))
+    return write_csv(scan_table(report, grouping, excluded=True))
 
 
 def render_diff(report: DiffReport) -> str:
     """One table: a row per location and the total (summary fields), then a row per element
     (its pre/post metrics and Γ counts); cells that do not apply are empty."""
-    return _csv(diff_table(report))
+    return write_csv(diff_table(report))
 
 
 def render_series(report: SeriesReport) -> str:
@@ -49,10 +49,10 @@ def render_series(report: SeriesReport) -> str:
 
 
 def render_compare(report: CompareReport) -> str:
-    return _csv(trend_table(report))
+    return write_csv(trend_table(report))
 
 
 def render_estimate(report: EstimateReport) -> str:
     """The diff's rows (a row per location, then per element) for every architecture and
     stage, named in the first two columns; with --actual, each figure's error instead."""
-    return _csv(estimate_table(report) if report.actual is None else accuracy_table(report))
+    return write_csv(estimate_table(report) if report.actual is None else accuracy_table(report))

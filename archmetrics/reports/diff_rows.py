@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from archmetrics.changeset.model import ElementChange, Metrics, Summary
 from archmetrics.reports.model import LOCATION_COLUMNS, CompareReport, DiffReport, SeriesReport
 
@@ -150,3 +152,48 @@ def compare_rows(compare: CompareReport) -> list[list[str]]:
         for series_rows in per_series.values():
             rows.extend(r for r in series_rows if r[2] == location)
     return rows
+
+
+def unmatched_glob(glob: str) -> str:
+    """The warning for a location or exclude glob that matched no file."""
+    return (
+        f"the glob {glob!r} matched no file archmetrics measures, before or after"
+        " (a typo, or quotes kept around it?)"
+    )
+
+
+def unparsed_line(report: DiffReport) -> list[str]:
+    """A line naming the touched files that could not be parsed, when there are any."""
+    count = report.change.total.unparsed
+    if not count:
+        return []
+    return [
+        f"{count} changed file(s) could not be parsed (a syntax error?) and are left out of"
+        " every number (listed as excluded, not_parsed); gate on them: unparsed(total) > 0"
+    ]
+
+
+def most_changed_first(changes: Iterable[ElementChange]) -> list[ElementChange]:
+    """Most changed statements first, then the largest complexity change, then by name:
+    the order every report lists changed elements in."""
+
+    def key(change: ElementChange) -> tuple[int, int, str]:
+        delta_vg = (change.post.vg if change.post else 0) - (change.pre.vg if change.pre else 0)
+        return (-(change.added + change.removed + change.modified), -abs(delta_vg), change.element)
+
+    return sorted(changes, key=key)
+
+
+def verdict(report: DiffReport) -> str:
+    """The run in one line: the change's size and cost, and whether its gates hold."""
+    total = report.change.total
+    failed = len(report.failed)
+    said = (
+        f"{failed} gate failure(s)"
+        if failed
+        else ("all gates hold" if report.gates else "no gates configured")
+    )
+    return (
+        f"Γ = {total.changes} statements changed, ΔVg = {total.delta_vg}, E = "
+        f"{number(total.cost)}: {said}"
+    )

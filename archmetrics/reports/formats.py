@@ -12,6 +12,7 @@ from archmetrics.reports import (
     markdown_report,
     sarif_report,
     table_report,
+    warnings_report,
 )
 from archmetrics.reports.model import (
     CompareReport,
@@ -30,6 +31,7 @@ class OutputFormat(StrEnum):
     CSV = "csv"
     CODECLIMATE = "codeclimate"  # GitLab Code Quality: failed gates and thresholds as issues
     SARIF = "sarif"  # GitHub code scanning: the same findings as SARIF 2.1.0 results
+    WARNINGS = "warnings"  # compilers' `path:line:col: error: ...`, one a line, worst first
 
 
 class Grouping(StrEnum):
@@ -50,6 +52,7 @@ _SCAN: dict[OutputFormat, ScanRenderer] = {
     OutputFormat.CSV: csv_report.render_scan,
     OutputFormat.CODECLIMATE: codeclimate_report.render_scan,
     OutputFormat.SARIF: sarif_report.render_scan,
+    OutputFormat.WARNINGS: warnings_report.render_scan,
 }
 assert set(_SCAN) == set(OutputFormat), "every output format needs a scan renderer"
 
@@ -73,6 +76,7 @@ _DIFF: dict[OutputFormat, Callable[[DiffReport], str]] = {
     OutputFormat.CSV: csv_report.render_diff,
     OutputFormat.CODECLIMATE: codeclimate_report.render_diff,
     OutputFormat.SARIF: sarif_report.render_diff,
+    OutputFormat.WARNINGS: warnings_report.render_diff,
 }
 assert set(_DIFF) == set(OutputFormat), "every output format needs a diff renderer"
 
@@ -92,6 +96,7 @@ _SERIES: dict[OutputFormat, Callable[[SeriesReport], str]] = {
     OutputFormat.CSV: csv_report.render_series,
     OutputFormat.CODECLIMATE: codeclimate_report.render_series,
     OutputFormat.SARIF: sarif_report.render_series,
+    OutputFormat.WARNINGS: warnings_report.render_series,
 }
 _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
     OutputFormat.TABLE: table_report.render_compare,
@@ -100,6 +105,7 @@ _COMPARE: dict[OutputFormat, Callable[[CompareReport], str]] = {
     OutputFormat.CSV: csv_report.render_compare,
     OutputFormat.CODECLIMATE: codeclimate_report.render_compare,
     OutputFormat.SARIF: sarif_report.render_compare,
+    OutputFormat.WARNINGS: warnings_report.render_compare,
 }
 assert set(_SERIES) == set(_COMPARE) == set(OutputFormat), "every format needs series/compare"
 
@@ -121,6 +127,7 @@ _ESTIMATE: dict[OutputFormat, Callable[[EstimateReport], str]] = {
     OutputFormat.CSV: csv_report.render_estimate,
     OutputFormat.CODECLIMATE: codeclimate_report.render_estimate,
     OutputFormat.SARIF: sarif_report.render_estimate,
+    OutputFormat.WARNINGS: warnings_report.render_estimate,
 }
 assert set(_ESTIMATE) == set(OutputFormat), "every output format needs an estimate renderer"
 

@@ -17,6 +17,7 @@ from archmetrics.reports.model import (
     CompareReport,
     DiffReport,
     EstimateReport,
+    HistoryReport,
     ScanReport,
     SeriesReport,
 )
@@ -127,6 +128,14 @@ def _trend_rows(approach: str, series: SeriesReport) -> list[tuple[Cell, ...]]:
             values = tuple(getattr(summary, f) for f, _ in TREND_FIELDS)
             rows.append((approach, stage.label, location, *values))
     return rows
+
+
+def history_table(report: HistoryReport) -> Table:
+    """A row per commit and location: the commit, its date (ISO 8601, UTC) and subject,
+    then the trend fields, Γ_A, Γ_R, Γ_M and Vg_post."""
+    from archmetrics.reports.history_rows import TABLE_FIELDS, long_rows
+
+    return Table(("commit", "date", "subject", "location", *TABLE_FIELDS), long_rows(report))
 
 
 def estimate_table(report: EstimateReport) -> Table:

@@ -5,12 +5,16 @@ from __future__ import annotations
 import heapq
 import json
 import re
+from collections.abc import Iterable, Mapping
 from operator import itemgetter
 from typing import Any
 
+from archmetrics import __version__
 from archmetrics.changeset.accuracy import Accuracy
-from archmetrics.changeset.model import ChangeReport
+from archmetrics.changeset.gates import is_unit_gate, measured_values, parse_gate
+from archmetrics.changeset.model import ChangeReport, Summary
 from archmetrics.complexity import FileMetrics, Totals
+from archmetrics.complexity.thresholds import ThresholdFailure
 from archmetrics.facts import ParseWarning
 from archmetrics.reports import coupling_rows
 from archmetrics.reports.model import (
@@ -81,23 +85,34 @@ def scan_dict(report: ScanReport) -> dict[str, Any]:
         "totals": totals_dict(report.totals),
         "elements": coupling_rows.elements_json(report),
         "excluded": [x.to_dict() for x in report.excluded],
-        "gates": [
-            {
-                "gate": gate,
-                "failed": any(f.threshold.text == gate for f in report.failures),
-                "failures": [
-                    {
-                        "name": f.unit.name,
-                        "path": f.unit.path,
-                        "line": f.unit.line,
-                        "values": {field: f.unit.values[field] for field in f.threshold.fields},
-                    }
-                    for f in report.failures
-                    if f.threshold.text == gate
-                ],
-            }
-            for gate in report.gates
-        ],
+        "gates": [unit_gate(gate, report) for gate in report.gates],
+        "notes": list(report.notes),
+    }
+
+
+def _units(failures: Iterable[ThresholdFailure], gate: str) -> list[dict[str, Any]]:
+    return [
+        {
+            "name": f.unit.name,
+            "path": f.unit.path,
+            "line": f.unit.line,
+            "values": {field: f.unit.values[field] for field in f.threshold.fields},
+        }
+        for f in failures
+        if f.threshold.text == gate
+    ]
+
+
+def unit_gate(gate: str, report: ScanReport | DiffReport) -> dict[str, Any]:
+    """A threshold's (a unit gate's) entry: whether it failed, every unit that failed it,
+    and those a suppression comment exempts or the baseline knows (listed, not failing)."""
+    failures = report.failures if isinstance(report, ScanReport) else report.offenders
+    return {
+        "gate": gate,
+        "failed": any(f.threshold.text == gate for f in failures),
+        "failures": _units(failures, gate),
+        "suppressed": _units(report.suppressed, gate),
+        "baselined": _units(report.baselined, gate),
     }
 
 
@@ -157,16 +172,30 @@ def render_scan(report: ScanReport) -> str:
 
 def diff_dict(report: DiffReport) -> dict[str, Any]:
     failed = {f.gate.text for f in report.failures}
+    summaries = report.summaries()
     return {
         "schema": DIFF_SCHEMA,
         "base": report.base,
         "head": report.head,
-        "locations": {name: s.to_dict() for name, s in report.summaries().items()},
+        "locations": {name: s.to_dict() for name, s in summaries.items()},
         "elements": element_records(report.change),
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
-        "gates": [{"gate": g, "failed": g in failed} for g in report.gates],
+        "gates": [
+            {**unit_gate(g, report), "values": {}}
+            if is_unit_gate(g)
+            else {"gate": g, "failed": g in failed, "values": gate_values(g, summaries)}
+            for g in report.gates
+        ],
+        "base_commit": report.commits[0],
+        "head_commit": report.commits[1],
+        "tool": {"name": "archmetrics", "version": __version__},
     }
+
+
+def gate_values(text: str, summaries: Mapping[str, Summary]) -> dict[str, float | None]:
+    """What each condition of the gate ``text`` measured (``FIELD(LOCATION)``: value)."""
+    return measured_values(parse_gate(text), summaries)
 
 
 def element_records(change: ChangeReport) -> list[dict[str, Any]]:

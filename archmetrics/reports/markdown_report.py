@@ -6,6 +6,7 @@ from collections.abc import Iterable, Sequence
 
 from archmetrics.changeset.model import ElementChange
 from archmetrics.reports import coupling_rows, diff_rows, estimate_rows
+from archmetrics.reports.glossary import DIFF_LEGEND, ELEMENT_LEGEND, SCAN_LEGEND
 from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
@@ -58,15 +59,17 @@ def render_scan(report: ScanReport, grouping: str) -> str:
         f"## archmetrics scan: `{report.revision}`\n",
         f"{t.files} files, {t.functions} functions: λ = {t.loc}, SLOC = {t.sloc}, v_g = {t.vg}\n",
         _scan_table(report, grouping),
+        f"<sub>{SCAN_LEGEND}{' ' + ELEMENT_LEGEND if grouping == 'element' else ''}</sub>\n",
     ]
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     if warnings:
         parts.append("\n**Warnings**\n\n" + "".join(f"- `{w}`\n" for w in warnings))
     if report.excluded:
         parts.append("".join(f"- excluded `{x.path}`: {x.reason}\n" for x in report.excluded))
+    parts += [f"*Note: {note}*\n" for note in report.notes]
     if report.gates:
         verdict = f"**{len(report.failures)} failing unit(s)**" if report.failures else "all hold"
-        lines = "".join(f"- {line}\n" for line in gate_lines(report))
+        lines = "".join(f"- {escape(line)}\n" for line in gate_lines(report))
         gates = ", ".join(f"`{gate}`" for gate in report.gates)
         parts.append(f"\n**Gates** ({gates}): {verdict}\n\n{lines}")
     return "\n".join(parts)
@@ -77,16 +80,10 @@ _ROOM = 1_000  # for the lines that say what was left out
 _SHOWN_EXCLUDED = 20
 
 
-def _worst_first(change: ElementChange) -> tuple[int, int, str]:
-    """Most changed statements first, then the largest complexity change, then by name."""
-    delta_vg = (change.post.vg if change.post else 0) - (change.pre.vg if change.pre else 0)
-    return (-(change.added + change.removed + change.modified), -abs(delta_vg), change.element)
-
-
 def _elements(changed: list[ElementChange], budget: int, max_rows: int | None) -> list[str]:
     """The changed elements' table, worst first: at most ``max_rows`` rows (0: all), or by
     default as many as fit in ``budget`` characters, and a line saying what was left out."""
-    rows = [diff_rows.element_row(e) for e in sorted(changed, key=_worst_first)]
+    rows = [diff_rows.element_row(e) for e in diff_rows.most_changed_first(changed)]
     header, align = list(diff_rows.ELEMENT_HEADER), "lll" + "r" * 11
     if max_rows:
         shown = rows[:max_rows]
@@ -116,19 +113,19 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
     """A pull-request comment: verdict line, summary table, changed elements (worst first),
     notes. By default the comment fits GitHub's limit (``COMMENT_LIMIT``): the elements that
     do not fit are counted, not shown; ``max_rows``: at most that many (0: every one)."""
-    total = report.change.total
-    verdict = (
-        f"**{len(report.failures)} gate(s) failed**"
-        if report.failures
-        else ("all gates hold" if report.gates else "no gates configured")
-    )
+    line = diff_rows.verdict(report)
+    if report.failed:
+        head, _, said = line.rpartition(": ")
+        line = f"{head}: **{said}**"
     parts = [
         f"## archmetrics: `{report.base}` → `{report.head}`\n",
-        f"Γ = {total.changes} changed statements, ΔVg = {total.delta_vg}, "
-        f"E = {diff_rows.number(total.cost)} · {verdict}\n",
+        line + "\n",
         table(["metric", "eq.", *LOCATION_COLUMNS], diff_rows.summary_rows(report), "llrrrr"),
+        f"<sub>{DIFF_LEGEND}</sub>\n",
     ]
     bullets = [f"- {f}" for f in report.failures]
+    bullets += [f"- {escape(line)}" for line in gate_lines(report)]
+    bullets += [f"- **{line}**" for line in diff_rows.unparsed_line(report)]
     bullets += [f"- note {n}" for n in diff_rows.notes(report)]
     excluded = report.change.excluded
     bullets += [f"- excluded `{x.path}`: {x.reason}" for x in excluded[:_SHOWN_EXCLUDED]]
@@ -136,6 +133,7 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
         more = len(excluded) - _SHOWN_EXCLUDED
         bullets.append(f"- ... and {more} more excluded files (`--format json` lists them all)")
     bullets += [f"- warning `{w}`" for w in shown_warnings(report.warnings)]
+    bullets += [f"- warning: {diff_rows.unmatched_glob(g)}" for g in report.change.unmatched]
     tail = ["\n".join(bullets) + "\n"] if bullets else []
     changed = report.change.changed()
     if changed:

@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from archmetrics.changeset.accuracy import ChangeAccuracy
-from archmetrics.changeset.gates import GateFailure
+from archmetrics.changeset.gates import GateFailure, GateOrigin
+from archmetrics.changeset.history import CommitStep
 from archmetrics.changeset.model import ChangeReport, ExcludedFile, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
@@ -32,6 +33,9 @@ class ScanReport:
     excluded: tuple[ExcludedFile, ...] = ()  # left out by the configuration's `exclude`
     gates: tuple[str, ...] = ()  # the thresholds checked (--fail-on)
     failures: tuple[ThresholdFailure, ...] = ()  # every unit that failed one
+    suppressed: tuple[ThresholdFailure, ...] = ()  # would fail: a comment exempts them
+    baselined: tuple[ThresholdFailure, ...] = ()  # would fail: the baseline knows them
+    notes: tuple[str, ...] = ()  # what the reader should know: nothing to measure
 
     def element_rows(self) -> list[ElementRow]:
         """Per element: its files, summed λ, SLOC and v_g, and its coupling."""
@@ -80,6 +84,20 @@ class DiffReport:
     warnings: tuple[ParseWarning, ...] = ()
     gates: tuple[str, ...] = ()  # the gate expressions checked
     failures: tuple[GateFailure, ...] = ()
+    offenders: tuple[ThresholdFailure, ...] = ()  # touched functions, files over a unit gate
+    suppressed: tuple[ThresholdFailure, ...] = ()  # would fail: a comment exempts them
+    baselined: tuple[ThresholdFailure, ...] = ()  # would fail: the baseline knows them
+    origins: tuple[GateOrigin, ...] = ()  # where the configured gates are written
+    commits: tuple[str | None, str | None] = (None, None)  # base's and head's commit ids
+
+    @property
+    def failed(self) -> tuple[GateFailure | ThresholdFailure, ...]:
+        """Every failure: the location gates', then the touched units' (worst first)."""
+        return (*self.failures, *self.offenders)
+
+    def origin(self, gate: str) -> GateOrigin | None:
+        """Where ``gate`` is written, if a configuration file sets it."""
+        return next((o for o in self.origins if o.gate == gate), None)
 
     def summaries(self) -> dict[str, Summary]:
         """Per location and the total, keyed base, new, framework, total."""
@@ -102,8 +120,8 @@ class SeriesReport:
     stages: tuple[Stage, ...]
 
     @property
-    def failures(self) -> tuple[GateFailure, ...]:
-        return tuple(f for s in self.stages for f in s.report.failures)
+    def failures(self) -> tuple[GateFailure | ThresholdFailure, ...]:
+        return tuple(f for s in self.stages for f in s.report.failed)
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,7 +131,7 @@ class CompareReport:
     series: tuple[tuple[str, SeriesReport], ...]
 
     @property
-    def failures(self) -> tuple[GateFailure, ...]:
+    def failures(self) -> tuple[GateFailure | ThresholdFailure, ...]:
         return tuple(f for _, s in self.series for f in s.failures)
 
 
@@ -169,6 +187,7 @@ class EstimateReport:
     failures: tuple[EstimateFailure, ...] = ()
     actual: DiffReport | None = None  # --actual: the change measured afterwards
     accuracy: tuple[tuple[str, ChangeAccuracy], ...] = ()  # per architecture, against it
+    plan_path: str | None = None  # the plan file relative to the repository (None: outside)
 
     def compare(self) -> CompareReport:
         """The architectures as series side by side (what series and compare render)."""
@@ -198,3 +217,38 @@ class EstimateReport:
                 for i, (name, t) in enumerate(totals, start=1)
             ]
         return tuple(ranked)
+
+
+HISTORY_SCHEMA = "archmetrics.history/1"
+
+
+@dataclass(frozen=True, slots=True)
+class HistoryEntry:
+    """One commit of a history against its first parent (``parent`` None: a root commit,
+    against the empty tree), with the gates that fail on it."""
+
+    commit: str
+    parent: str | None
+    time: int  # committer date, seconds since the epoch (UTC)
+    subject: str
+    merge: bool
+    step: CommitStep
+    failures: tuple[GateFailure, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class HistoryReport:
+    """Every commit of a range, oldest first. ``measured``: how many commits this run
+    measured (the others' steps were kept from an earlier run); ``parsed``: how many file
+    versions it parsed."""
+
+    repo: str
+    range: str
+    entries: tuple[HistoryEntry, ...]
+    gates: tuple[str, ...] = ()
+    measured: int = 0
+    parsed: int = 0
+
+    @property
+    def failures(self) -> tuple[GateFailure, ...]:
+        return tuple(f for e in self.entries for f in e.failures)

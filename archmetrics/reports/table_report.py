@@ -10,7 +10,9 @@ from typing import Literal
 from rich.console import Console
 from rich.table import Table
 
+from archmetrics.complexity.thresholds import ThresholdFailure, worst_first
 from archmetrics.reports import coupling_rows, diff_rows, estimate_rows
+from archmetrics.reports.glossary import DIFF_LEGEND, ELEMENT_LEGEND, SCAN_LEGEND
 from archmetrics.reports.model import (
     LOCATION_COLUMNS,
     CompareReport,
@@ -127,17 +129,34 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     warnings = shown_warnings([w for f in report.files for w in f.warnings])
     extra = ["", "warnings:", *("  " + w for w in warnings)] if warnings else []
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
-    extra += gate_lines(report)
+    extra += [f"note: {note}" for note in report.notes]
+    legend = SCAN_LEGEND + (" " + ELEMENT_LEGEND if grouping == "element" else "")
+    extra += [f"legend: {legend}", *gate_lines(report)]
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
 
 
 SHOWN_FAILURES = 50  # failed units listed in a table, Markdown or on stderr; JSON lists all
 
 
-def gate_lines(report: ScanReport) -> list[str]:
-    """The scan's failed thresholds, one line per failing unit, at most ``SHOWN_FAILURES``."""
+def gate_lines(report: ScanReport | DiffReport) -> list[str]:
+    """The failed thresholds (a diff: its touched units over a unit gate), one line per
+    failing unit, worst first, at most ``SHOWN_FAILURES``; then the units a suppression
+    comment exempts (every one: nothing hides silently) and those the baseline knows."""
+    failures = report.failures if isinstance(report, ScanReport) else report.offenders
     more = "... and {count} more failing units (--format json lists them all)"
-    return shown_lines(report.failures, SHOWN_FAILURES, more)
+    lines = shown_lines(worst_first(failures), SHOWN_FAILURES, more)
+    lines += [f"suppressed by a comment: {_excused(f)}" for f in worst_first(report.suppressed)]
+    if report.baselined:
+        known = worst_first(report.baselined)
+        lines.append(f"{len(known)} offenders the baseline knows, none worse (not failing):")
+        more = "  ... and {count} more (--format json lists them all)"
+        lines += [f"  {_excused(f)}" for f in known[:SHOWN_FAILURES]]
+        lines += [more.format(count=len(known) - SHOWN_FAILURES)] * (len(known) > SHOWN_FAILURES)
+    return lines
+
+
+def _excused(failure: ThresholdFailure) -> str:
+    return str(failure).removeprefix("gate failed: ")
 
 
 def render_diff(report: DiffReport, color: bool = False) -> str:
@@ -149,19 +168,27 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
         summary.add_column(column, justify="right")
     for row in diff_rows.summary_rows(report):
         summary.add_row(*row)
-    changed = [diff_rows.element_row(e) for e in report.change.changed()]
+    changed = [
+        diff_rows.element_row(e) for e in diff_rows.most_changed_first(report.change.changed())
+    ]
     least_useful = ("d_e", "d_a", "s_e", "s_a", "location", "λ pre", "v_g pre")
-    detail = rows_table("elements", diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
+    title = "changed elements, the most changed first"
+    detail = rows_table(title, diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
     linked = diff_rows.link_rows(report.change.changed())
     tables = [summary, detail]
     if linked:
         tables.append(rows_table("links added and removed", diff_rows.LINK_HEADER, linked, 1))
     unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
+    lines.append(f"legend: {DIFF_LEGEND}")
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]
+    lines += [f"warning: {diff_rows.unmatched_glob(g)}" for g in report.change.unmatched]
+    lines += diff_rows.unparsed_line(report)
     lines += [str(f) for f in report.failures]
+    lines += gate_lines(report)
+    lines.append(f"verdict: {diff_rows.verdict(report)}")
     return to_text(*tables, color=color) + "".join(line + "\n" for line in lines)
 
 

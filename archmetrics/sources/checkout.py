@@ -60,6 +60,35 @@ class Checkout:
 
         return {} if self.repo is None else git.renames(self.repo, base, head)
 
+    def merge_base(self, first: str, second: str) -> str:
+        """The commit ``git diff first...second`` compares from (``second`` WORKTREE or
+        INDEX: from HEAD's merge base, as ``git diff --merge-base first`` does)."""
+        from archmetrics.sources import git
+
+        if self.repo is None:
+            raise SourceError(f"{self.root}: not inside a git repository")
+        special = (EMPTY, WORKTREE, INDEX)
+        if first in special or second == EMPTY:
+            raise SourceError(f"{first}...{second}: a merge base needs two commits")
+        return git.merge_base(self.repo, first, "HEAD" if second in special else second)
+
+    def commit_id(self, spec: str) -> str | None:
+        """The commit ``spec`` names; None for EMPTY, WORKTREE, INDEX, outside git, or HEAD
+        before the first commit."""
+        from archmetrics.sources import git
+
+        if self.repo is None or spec in (EMPTY, WORKTREE, INDEX):
+            return None
+        if git.effective_spec(self.repo, spec) == EMPTY:
+            return None
+        return git.resolve(self.repo, spec)
+
+    def staged_paths(self) -> frozenset[str]:
+        """The paths the index changes against HEAD (none outside git)."""
+        from archmetrics.sources import git
+
+        return frozenset() if self.repo is None else git.staged_paths(self.repo)
+
     def tags(self) -> tuple[str, ...]:
         """The repository's tags, oldest first (``git.tags_in_order``)."""
         from archmetrics.sources import git

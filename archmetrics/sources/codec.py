@@ -94,6 +94,7 @@ def encode(facts: FileFacts) -> bytes:
                 f.statements,
                 [[d.kind, d.line] for d in f.decisions],
                 list(f.parameters),
+                list(f.suppressed),
             ]
             for f in facts.functions
         ],
@@ -329,9 +330,10 @@ def _decode(
                         tuple([_new(Decision, (intern(k), line)) for k, line in ds]),
                         st,
                         tuple([intern(p) for p in ps]),
+                        tuple(sp),
                     ),
                 )
-                for n, q, a, b, st, ds, ps in functions
+                for n, q, a, b, st, ds, ps, sp in functions
             ]
         ),
         classes=tuple([Class(n, q, spans[a, b], k) for n, q, a, b, k in classes]),

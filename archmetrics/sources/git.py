@@ -134,6 +134,33 @@ def resolve(repo: git.Repo, rev: str) -> str:
     return out.strip()
 
 
+def merge_base(repo: git.Repo, first: str, second: str) -> str:
+    """The best common ancestor of two revisions, as ``git diff A...B`` compares from;
+    SourceError when they share no history, or when a shallow clone cuts it off (with the
+    fix: fetch the history)."""
+    ends = (resolve(repo, first), resolve(repo, second))
+    try:
+        out: str = repo.git.execute(["git", "merge-base", "--end-of-options", *ends])
+    except GitCommandError as error:
+        if error.status != 1 or str(error.stderr or "").strip():
+            raise explain(repo, error, f"the merge base of {first} and {second}") from error
+        if _is_shallow(repo):
+            raise SourceError(
+                f"{first} and {second}: no merge base in this shallow clone; fetch the history"
+                " first (git fetch --deepen=200, or --unshallow; fetch-depth: 0 in CI)"
+            ) from error
+        raise SourceError(f"{first} and {second} share no history: no merge base") from error
+    return out.strip().splitlines()[0]
+
+
+def staged_paths(repo: git.Repo) -> frozenset[str]:
+    """The paths the index changes against HEAD (every indexed path with no commit yet)."""
+    if not has_commits(repo):
+        return frozenset(quote_path(p) for p in _ls(repo, "ls-files", "-z"))
+    listed = _ls(repo, "diff-index", "--cached", "--name-only", "--no-renames", "-z", "HEAD")
+    return frozenset(quote_path(p) for p in listed)
+
+
 def has_commits(repo: git.Repo) -> bool:
     try:
         repo.git.execute(["git", "rev-parse", "--verify", "--quiet", "HEAD^{commit}"])
@@ -180,17 +207,21 @@ class _BlobReader:
 
 
 class RevisionSnapshot(_BlobReader):
-    """The tree of a commit."""
+    """The tree of a commit. ``commit`` and ``tree``: the ids, when the caller knows them
+    already (a history lists both for every commit), so that git is not asked again."""
 
-    def __init__(self, repo: git.Repo, rev: str):
+    def __init__(self, repo: git.Repo, rev: str, commit: str = "", tree: str = ""):
         super().__init__(repo)
-        self.commit = resolve(repo, rev)
+        self.commit = commit or resolve(repo, rev)
         self.label = rev
+        self._tree = tree
 
     @property
     def tree(self) -> str:
         """The commit's tree id: what names this snapshot's content."""
-        return _ls(self.repo, "rev-parse", f"{self.commit}^{{tree}}")[0].strip()
+        if not self._tree:
+            self._tree = _ls(self.repo, "rev-parse", f"{self.commit}^{{tree}}")[0].strip()
+        return self._tree
 
     def delta_from(self, commit: str) -> Pending:
         """What differs from ``commit`` (a commit id) to this commit (gitdelta.py)."""
@@ -204,6 +235,16 @@ class RevisionSnapshot(_BlobReader):
             if kind == "blob" and mode != "120000":  # skip symlinks and submodules
                 found.append(SourceFile(quote_path(path), blob))
         return tuple(sorted(found))
+
+
+class Blobs(_BlobReader):
+    """A repository's blobs, read by id: the file versions a history parses before it walks
+    the commits that hold them."""
+
+    label = "history"
+
+    def files(self) -> tuple[SourceFile, ...]:
+        return ()
 
 
 class IndexSnapshot(_BlobReader):

@@ -46,11 +46,12 @@ class _Git:
         self.repo = repo
         self.env = {**os.environ, **repo.git.environment()}
 
-    def start(self, *args: str) -> tuple[list[str], subprocess.Popen[bytes]]:
+    def start(self, *args: str, stdin: bool = False) -> tuple[list[str], subprocess.Popen[bytes]]:
         command = ["git", *args]
         process = subprocess.Popen(
             command, cwd=self.repo.working_dir, env=self.env,
-            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            stdin=subprocess.PIPE if stdin else subprocess.DEVNULL,
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
         )  # fmt: skip
         return command, process
 
@@ -173,10 +174,24 @@ class Pending:
         self._finish = None
 
 
+def start_git(
+    repo: gitpython.Repo, *args: str, stdin: bool = False
+) -> tuple[list[str], subprocess.Popen[bytes]]:
+    """``git ARGS`` started in ``repo`` with its read-only environment (stdin a pipe when
+    asked for); the caller reads it."""
+    return _Git(repo).start(*args, stdin=stdin)
+
+
+def read_delta(fields: Sequence[str]) -> Delta | None:
+    """The delta of ``diff-tree -z --raw`` fields between two trees (None for a record this
+    cannot take)."""
+    read = _read_raw(fields)
+    return None if read is None else _delta(*read, (), lambda path: True)
+
+
 def _pending(runner: _Git, started: tuple[list[str], subprocess.Popen[bytes]]) -> Pending:
     def finish() -> Delta | None:
-        read = _read_raw(_fields(runner.finish(started)))
-        return None if read is None else _delta(*read, (), lambda path: True)
+        return read_delta(_fields(runner.finish(started)))
 
     return Pending(finish, [started[1]])
 

@@ -173,7 +173,8 @@ def _costs_text(e: Mapping[str, float]) -> str:
 # One tolerance for every unquantified word of the thesis about E: "relatively constant"
 # (p. 133) and "near constant" (p. 142) mean within NEAR of each other; "large jump" (p. 135),
 # "drop sharply" (p. 135) and "increases significantly" (p. 135) mean a change beyond it.
-# Set to 1.25 before issue 15; since then applied to results already known (docs/study.md).
+# docs/study.md, "How the thresholds were chosen", says what was known of the results when
+# each threshold was chosen and what the verdicts would be under the readings they replace.
 NEAR = 1.25
 
 

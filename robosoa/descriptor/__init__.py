@@ -25,12 +25,12 @@ from .model import (
     Participant,
     Pattern,
     Profile,
-    ServiceDescriptor,
     StreamQos,
     TypeDef,
     TypeRef,
 )
 from .payload import PayloadError, check_value, reply_validator, request_validator
+from .service import ServiceDescriptor
 
 __all__ = [
     "PRIMITIVES",

@@ -19,11 +19,11 @@ from .model import (
     Parameter,
     Participant,
     Pattern,
-    ServiceDescriptor,
     StreamQos,
     TypeRef,
 )
 from .names import name_problems
+from .service import ServiceDescriptor
 
 MAX_TIMEOUT = 86_400  # seconds a provider program may be given (one day)
 _PUBSUB_FORMS = (Packaging.PROVIDER_LIBRARY, Packaging.CONSUMER_SOURCE)

@@ -35,12 +35,12 @@ from .model import (
     Participant,
     Pattern,
     Profile,
-    ServiceDescriptor,
     StreamQos,
     TypeDef,
     TypeRef,
 )
 from .names import default_naming
+from .service import ServiceDescriptor
 
 _Element = etree._Element
 

@@ -6,8 +6,7 @@ point back at the XML that produced it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
@@ -235,55 +234,3 @@ class Participant:
     naming: Naming
     group: str | None
     line: int
-
-
-@dataclass(frozen=True, slots=True)
-class ServiceDescriptor:
-    """A whole service profile: interface, data types and the participants to generate."""
-
-    name: str
-    version: str
-    definition: str
-    pattern: Pattern
-    delivery: str
-    types: tuple[TypeDef, ...]
-    operations: tuple[Operation, ...]
-    participants: tuple[Participant, ...]
-    source: str
-    text: str = field(repr=False)
-    line: int = 0
-
-    def operation(self, name: str) -> Operation | None:
-        """The operation called ``name``, if any."""
-        return next((op for op in self.operations if op.name == name), None)
-
-    def type(self, name: str) -> TypeDef | None:
-        """The struct type called ``name``, if any."""
-        return next((t for t in self.types if t.name == name), None)
-
-    def participant(self, packaging: Packaging) -> Participant | None:
-        """The participant packaged as ``packaging``, if the descriptor declares one."""
-        return next((p for p in self.participants if p.packaging == packaging), None)
-
-    def qos(self, operation: str) -> QoS:
-        """The QoS of the topic or event ``operation`` (the default without ``<qos>``), for
-        ``bus.advertise`` and ``bus.subscribe``; generated code passes it."""
-        op = self.operation(operation)
-        if op is None:
-            raise KeyError(f"service '{self.name}' has no operation '{operation}'")
-        return op.qos.settings() if op.qos is not None else QoS()
-
-    def validator(self) -> Callable[[str, Mapping[str, Any]], None]:
-        """A request checker ``(operation, payload) -> None`` for ``bus.provide(validator=)``.
-
-        It raises ``robosoa.InvalidMessage`` naming the operation and the offending field.
-        """
-        from .payload import request_validator
-
-        return request_validator(self)
-
-    def reply_validator(self) -> Callable[[str, Mapping[str, Any]], None]:
-        """Like :meth:`validator`, for reply payloads against the declared return values."""
-        from .payload import reply_validator
-
-        return reply_validator(self)

@@ -23,8 +23,8 @@ from .model import (
     Participant,
     Pattern,
     Profile,
-    ServiceDescriptor,
 )
+from .service import ServiceDescriptor
 
 # Module-level names of generated modules (imports and definitions), the names their methods
 # rely on, and the builtins generated code calls. tests/robosoa/test_codegen_names.py checks

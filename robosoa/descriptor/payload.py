@@ -7,11 +7,11 @@ failures raise ``robosoa.InvalidMessage`` with a reason naming the operation and
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol
 
 from robosoa.errors import InvalidMessage
 
-from .model import Operation, Parameter, ServiceDescriptor, TypeRef
+from .model import Operation, Parameter, TypeDef, TypeRef
 
 Validator = Callable[[str, Mapping[str, Any]], None]
 
@@ -37,13 +37,24 @@ def _invalid(reason: str) -> InvalidMessage:
     return InvalidMessage(reason)
 
 
+class Declared(Protocol):
+    """What payload checking reads of a service descriptor (``service.ServiceDescriptor``)."""
+
+    @property
+    def name(self) -> str: ...
+
+    def operation(self, name: str) -> Operation | None: ...
+
+    def type(self, name: str) -> TypeDef | None: ...
+
+
 def _kind(value: object) -> str:
     names: dict[type, str] = {dict: "struct", list: "list", tuple: "list", str: "string",
                               bytearray: "bytes", memoryview: "bytes"}
     return names.get(type(value), type(value).__name__)
 
 
-def check_value(d: ServiceDescriptor, t: TypeRef, value: object, path: str) -> None:
+def check_value(d: Declared, t: TypeRef, value: object, path: str) -> None:
     """Raise :class:`PayloadError` unless ``value`` (wire form) matches type ``t``."""
     if t.item is not None:
         if not isinstance(value, list | tuple):
@@ -65,7 +76,7 @@ def check_value(d: ServiceDescriptor, t: TypeRef, value: object, path: str) -> N
 
 
 def check_fields(
-    d: ServiceDescriptor, fields: Sequence[Parameter], value: Mapping[str, Any], prefix: str
+    d: Declared, fields: Sequence[Parameter], value: Mapping[str, Any], prefix: str
 ) -> None:
     """Check a mapping against declared ``fields``: unknown, missing and mistyped ones."""
     declared = {f.name: f for f in fields}
@@ -80,14 +91,14 @@ def check_fields(
         check_value(d, f.type, value[f.name], f"{prefix}{f.name}")
 
 
-def _operation(d: ServiceDescriptor, name: str) -> Operation:
+def _operation(d: Declared, name: str) -> Operation:
     op = d.operation(name)
     if op is None:
         raise _invalid(f"service '{d.name}' has no operation '{name}'")
     return op
 
 
-def _checker(d: ServiceDescriptor, replies: bool) -> Validator:
+def _checker(d: Declared, replies: bool) -> Validator:
     def validate(operation: str, payload: Mapping[str, Any]) -> None:
         op = _operation(d, operation)
         what, fields = ("return", op.returns) if replies else ("parameter", op.parameters)
@@ -101,11 +112,11 @@ def _checker(d: ServiceDescriptor, replies: bool) -> Validator:
     return validate
 
 
-def request_validator(d: ServiceDescriptor) -> Validator:
+def request_validator(d: Declared) -> Validator:
     """A callable ``(operation, payload) -> None`` checking requests against ``d``."""
     return _checker(d, replies=False)
 
 
-def reply_validator(d: ServiceDescriptor) -> Validator:
+def reply_validator(d: Declared) -> Validator:
     """A callable ``(operation, payload) -> None`` checking replies against the returns of ``d``."""
     return _checker(d, replies=True)

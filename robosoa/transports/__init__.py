@@ -10,6 +10,7 @@ from importlib import import_module
 from importlib.metadata import entry_points
 
 from robosoa.errors import RobosoaError
+from robosoa.extras import missing
 from robosoa.transports.base import BusOptions, ProtocolAdapter
 
 BUILTIN: dict[str, str] = {
@@ -21,7 +22,14 @@ ENTRY_POINT_GROUP = "robosoa.transports"
 
 def _load(target: str) -> type[ProtocolAdapter]:
     module, _, name = target.partition(":")
-    found = getattr(import_module(module), name)
+    try:
+        loaded = import_module(module)
+    except ModuleNotFoundError as error:  # pyzmq: the runtime extra
+        said = missing(error, f"the transport {target.partition(':')[0]}")
+        if said is None:
+            raise
+        raise said from error
+    found = getattr(loaded, name)
     if not (isinstance(found, type) and issubclass(found, ProtocolAdapter)):
         raise RobosoaError(f"transport {target} is not a ProtocolAdapter subclass")
     return found

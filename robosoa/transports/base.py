@@ -44,7 +44,7 @@ def hand_out(sinks: Sequence[Sink], frames: list[bytes], expires: float, block: 
     """A message published on this bus, to its own subscriptions (``sinks``), on the
     publisher's thread: best-effort ones take it or drop it, reliable ones (``block`` given)
     are offered it until they take it or ``block`` seconds have passed (PublishTimeout)."""
-    msg = decode_frames(frames, options.max_message, options.max_depth)
+    msg = decode_frames(frames, options.max_message, options.max_depth, options.total)
     size = sum(map(len, frames))
     if block is None:
         for sink in sinks:
@@ -78,6 +78,7 @@ class BusOptions:
     provider_bind: str = ""  # zmq: where providers bind, e.g. "tcp://0.0.0.0"; "" = derive
     advertise_host: str = ""  # zmq: host name/IP other machines use to reach our providers
     max_message: int = MAX_MESSAGE  # bytes per frame taken from a peer (ZeroMQ MAXMSGSIZE)
+    max_total: int = 0  # bytes in all frames of one message taken from a peer; 0: max_message
     max_depth: int = MAX_DEPTH  # JSON nesting taken from a peer (robosoa.wire)
     link_heartbeat: float = 1.0  # zmq: seconds between ZMTP heartbeats on every connection
     link_timeout: float = 3.0  # zmq: a connection silent this long is closed (peer dead/cut off)
@@ -85,6 +86,12 @@ class BusOptions:
     curve_secret: str = ""  # zmq: this participant's certificate (NAME.key_secret); "" = off
     curve_allow: str = ""  # zmq: folder of the public certificates allowed on the bus
     curve_location: str = ""  # zmq: the location service's certificate (default allow/location.key)
+
+    @property
+    def total(self) -> int:
+        """Bytes one message from a peer may hold in all its frames (``max_total``, or
+        ``max_message`` when that is 0)."""
+        return self.max_total or self.max_message
 
 
 class Incoming(NamedTuple):

@@ -104,7 +104,7 @@ class _ReplySlot:
     def set(self, message: Message) -> None:
         options = self.options
         self.message = decode_frames(encode_frames(message), options.max_message,
-                                     options.max_depth)
+                                     options.max_depth, options.total)
         self.event.set()
 
 
@@ -180,7 +180,7 @@ class InprocAdapter(ProtocolAdapter):
     def _copy(self, msg: Message) -> Message:
         """The message as the receiver gets it: encoded and decoded within the same limits."""
         return decode_frames(encode_frames(msg), self.options.max_message,
-                             self.options.max_depth)
+                             self.options.max_depth, self.options.total)
 
     def open_inbox(self, instance: str) -> Inbox:
         broker = self._live()

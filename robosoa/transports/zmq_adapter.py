@@ -33,6 +33,7 @@ from robosoa.transports.base import (
     Unreachable,
 )
 from robosoa.transports.zmq_dealers import Dealers
+from robosoa.transports.zmq_guard import Guard
 from robosoa.transports.zmq_inbox import ZmqInbox
 from robosoa.transports.zmq_sockets import check_endpoint, public
 from robosoa.transports.zmq_topics import Topics
@@ -61,6 +62,7 @@ class ZmqAdapter(ProtocolAdapter):
                                  options.curve_location)
         self._auth: ThreadAuthenticator | None = None
         self._keys: dict[str, bytes] = {}  # endpoint -> its server's CURVE key (from lookups)
+        self._guard: Guard | None = None  # bounds what each provider connection holds
 
     # --- SOA_Base ---------------------------------------------------------------------
     def configure(self) -> None:
@@ -124,6 +126,9 @@ class ZmqAdapter(ProtocolAdapter):
             self._topics = None
         if self._dealers is not None:
             self._dealers.close()
+        if self._guard is not None:  # its monitors close before the context does
+            self._guard.close()
+            self._guard = None
         if self._auth is not None:
             self._auth.stop()
             self._auth = None
@@ -161,6 +166,8 @@ class ZmqAdapter(ProtocolAdapter):
         if not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
         rid = next(self._rids)
+        if request.get("op") == "lookup":  # the reply must fit our frame limit
+            request = {**request, "max_bytes": self.options.max_message}
         raw = json.dumps({**request, "rid": rid}).encode()
         deadline = time.monotonic() + timeout
         dealers = self._live_dealers()
@@ -169,10 +176,10 @@ class ZmqAdapter(ProtocolAdapter):
         except Unreachable:
             raise RobosoaError(f"location service at {self.endpoint} is not reachable") from None
 
-        def accept(frames: list[bytes]) -> dict[str, Any] | None:
+        def accept(frames: list[bytes] | None) -> dict[str, Any] | None:
             try:
-                if len(frames) != 1:
-                    raise InvalidMessage(f"expected one frame, got {len(frames)}")
+                if frames is None or len(frames) != 1:
+                    raise InvalidMessage("expected one frame")
                 reply = load_object(frames[0], self.options.max_message,
                                     self.options.max_depth)
             except InvalidMessage:
@@ -204,9 +211,12 @@ class ZmqAdapter(ProtocolAdapter):
         dealers = self._live_dealers()
         sock = dealers.send(endpoint, encode_frames(msg), min(timeout, CONNECT_WAIT))
 
-        def accept(frames: list[bytes]) -> Message | None:
+        def accept(frames: list[bytes] | None) -> Message | None:
             try:
-                reply = decode_frames(frames, self.options.max_message, self.options.max_depth)
+                if frames is None:
+                    raise InvalidMessage("reply too large in all its frames")
+                reply = decode_frames(frames, self.options.max_message, self.options.max_depth,
+                                      self.options.total)
             except InvalidMessage:
                 self.rejected("reply")
                 return None
@@ -249,7 +259,14 @@ class ZmqAdapter(ProtocolAdapter):
     def open_inbox(self, instance: str) -> Inbox:
         if self._ctx is None or not self.connected:
             raise BusClosed(f"bus {self.address} is not connected")
-        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected, self._curve)
+        if self._guard is None:
+            self._guard = Guard()
+        return ZmqInbox(self._ctx, self.endpoint, self.options, self.rejected, self._curve,
+                        self._guard, self._cut)
+
+    def _cut(self, peer: str) -> None:
+        """A provider connection from ``peer`` was shut down for holding too much."""
+        self.stats_book.counter("inbox", "wire").drop("budget")
 
     def _live_topics(self) -> Topics:
         if self._topics is None or not self.connected:

@@ -21,6 +21,7 @@ from robosoa.errors import BusClosed
 from robosoa.message import Frames
 from robosoa.transports.base import BusOptions, Lost, Unreachable
 from robosoa.transports.zmq_sockets import keepalive, limit_input, recv_rest, send_frames
+from robosoa.wire import LimitExceeded
 
 SLICE = 0.1  # seconds: blocking waits are cut in slices so closing the bus is prompt
 SLICE_MS = int(SLICE * 1000) + 1
@@ -113,9 +114,10 @@ class Dealers:
                 sock.poll(int(min(remaining, SLICE) * 1000) + 1, zmq.POLLOUT)
 
     def receive(self, sock: zmq.Socket[bytes], endpoint: str, deadline: float,
-                accept: Callable[[list[bytes]], Any]) -> Any:
-        """Wait for the reply ``accept`` recognises (stale replies are skipped); None at the
-        deadline or on closing; Lost when the connection goes away meanwhile.
+                accept: Callable[[list[bytes] | None], Any]) -> Any:
+        """Wait for the reply ``accept`` recognises (stale replies are skipped; a reply too
+        large in all its frames is handed to it as None); None at the deadline or on
+        closing; Lost when the connection goes away meanwhile.
 
         Blocks in ``recv`` with a receive timeout (no poller: cheaper on the hot path), in
         slices; after each empty slice the socket is asked whether its connection is up.
@@ -137,7 +139,12 @@ class Dealers:
             finally:
                 if wait != SLICE_MS:
                     sock.setsockopt(zmq.RCVTIMEO, SLICE_MS)
-            found = accept(recv_rest(sock, data) if sock.getsockopt(_RCVMORE) else [data])
+            try:
+                frames: list[bytes] | None = (recv_rest(sock, data, total=self._options.total)
+                                              if sock.getsockopt(_RCVMORE) else [data])
+            except LimitExceeded:  # more than max_total in all its frames: read, not kept
+                frames = None
+            found = accept(frames)
             if found is not None:
                 return found
 

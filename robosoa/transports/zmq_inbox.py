@@ -11,6 +11,7 @@ from robosoa.errors import InvalidMessage
 from robosoa.message import Kind, Message, decode_frames, encode_frames
 from robosoa.transports.base import BusOptions, Inbox, Incoming
 from robosoa.transports.zmq_curve import Curve
+from robosoa.transports.zmq_guard import CURVE_FRAMING, FRAMING, Guard, budget
 from robosoa.transports.zmq_sockets import (
     bind_provider,
     keepalive,
@@ -34,7 +35,8 @@ class ZmqInbox(Inbox):
 
     def __init__(self, ctx: zmq.Context[zmq.Socket[bytes]], location: str,
                  options: BusOptions, rejected: Callable[[str], None],
-                 curve: Curve | None = None) -> None:
+                 curve: Curve | None = None, guard: Guard | None = None,
+                 cut: Callable[[str], None] = lambda peer: None) -> None:
         self._ctx = ctx
         self._options = options
         self._rejected = rejected
@@ -52,6 +54,9 @@ class ZmqInbox(Inbox):
                                       options.provider_bind,
                                       options.advertise_host)
         self._bound = str(self._router.getsockopt_string(zmq.LAST_ENDPOINT))
+        self._watch = None if guard is None else guard.watch(
+            self._router, budget(options.total), FRAMING if curve is None else CURVE_FRAMING,
+            cut)
         self._token = uuid.uuid4().bytes
         self._timeout = -2
 
@@ -65,18 +70,30 @@ class ZmqInbox(Inbox):
             identity = router.recv()
         except zmq.Again:
             return None
-        data = router.recv() if router.getsockopt(_RCVMORE) else b""
-        frames = recv_rest(router, data) if router.getsockopt(_RCVMORE) else [data]
+        watch, first = self._watch, None
+        if not router.getsockopt(_RCVMORE):
+            data = b""
+        elif watch is None or identity in watch.fds:
+            data = router.recv()
+        else:  # a peer not seen before: its connection is found from a frame (ZMQ_SRCFD)
+            first = router.recv(copy=False)
+            data = first.bytes
 
         def reply(msg: Message) -> None:
             out = encode_frames(msg)
             router.send(identity, _MORE_NOBLOCK)
             send_frames(router, out, _NOBLOCK)
 
-        if len(frames) == 1 and data == self._token:
-            return None
         try:
-            msg = decode_frames(frames, self._options.max_message, self._options.max_depth)
+            frames = ([data] if not router.getsockopt(_RCVMORE) else
+                      recv_rest(router, data, total=self._options.total))
+            if watch is not None:
+                size = len(data) if len(frames) == 1 else sum(map(len, frames))
+                watch.took(identity, size, len(frames), first)
+            if len(frames) == 1 and data == self._token:
+                return None
+            msg = decode_frames(frames, self._options.max_message, self._options.max_depth,
+                                self._options.total)
         except InvalidMessage as exc:  # answered with an error reply by the provider
             self._rejected("inbox")
             return Incoming(None, str(exc), reply)

@@ -30,6 +30,7 @@ from robosoa.transports.base import BusOptions, Sink, hand_out
 from robosoa.transports.zmq_curve import Curve
 from robosoa.transports.zmq_outlet import MARK, META, prefix
 from robosoa.transports.zmq_sockets import Waker, keepalive, limit_input, recv_message
+from robosoa.wire import LimitExceeded
 
 log = logging.getLogger("robosoa.zmq")
 
@@ -183,7 +184,7 @@ class Feed:
         try:
             msg = (decode(body, options.max_message, options.max_depth) if len(frames) == 1
                    else decode_frames([body, *frames[1:]], options.max_message,
-                                      options.max_depth))
+                                      options.max_depth, options.total))
         except InvalidMessage as exc:
             self._rejected("broadcast")
             log.debug("malformed broadcast dropped", extra={"reason": str(exc)})
@@ -250,11 +251,15 @@ class Feed:
         not several at once past a byte budget). docs/runtime.md, Performance."""
         batch: list[Offer] = []
         gathered = 0
+        total = self._options.total
         for _ in range(BATCH):  # then look at commands again
             try:
-                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, total)
             except zmq.Again:
                 break
+            except LimitExceeded:  # read, not kept
+                self._rejected("broadcast")
+                continue
             try:
                 taken = self._take(frames)
             except Exception:  # never let one message end the subscriber thread
@@ -273,9 +278,12 @@ class Feed:
         message a subscription refused (held back until it has room)."""
         for _ in range(BATCH):
             try:
-                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2)
+                frames = recv_message(sub, _NOBLOCK, MAX_BLOBS + 2, self._options.total)
             except zmq.Again:
                 return
+            except LimitExceeded:  # read, not kept
+                self._rejected("broadcast")
+                continue
             try:
                 taken = self._take(frames)
                 if taken is not None and not self._offer(taken):

@@ -17,8 +17,8 @@ from typing import Any
 import zmq
 
 from robosoa.blobs import MAX_BLOBS
-from robosoa.errors import InvalidMessage, RobosoaError
-from robosoa.wire import MAX_MESSAGE, load_object
+from robosoa.errors import RobosoaError
+from robosoa.wire import MAX_MESSAGE, LimitExceeded
 
 
 def split_endpoint(endpoint: str) -> tuple[str, str, int]:
@@ -77,30 +77,41 @@ def send_frames(sock: zmq.Socket[bytes], frames: Sequence[bytes], flags: int = 0
         sock.send(frames[n], flags | _SNDMORE if n < last else flags, copy=False)
 
 
-def recv_rest(sock: zmq.Socket[bytes], first: bytes,
-              limit: int = MAX_BLOBS + 1) -> list[bytes]:
-    """``first`` and the other frames of the message it began (already arrived, whole).
+def recv_rest(sock: zmq.Socket[bytes], first: bytes, limit: int = MAX_BLOBS + 1,
+              total: int = MAX_MESSAGE) -> list[bytes]:
+    """``first`` and the other frames of the message it began (already arrived, whole),
+    read one by one.
 
     Frames past ``limit`` are read and thrown away, so a message of too many frames comes
-    back as ``limit + 1`` frames, which the decoder refuses.
+    back as ``limit + 1`` frames, which the decoder refuses. Once the frames hold more than
+    ``total`` bytes the rest are read without a copy and thrown away, and LimitExceeded says
+    so: at most ``total`` bytes and one frame of a message are ever copied out of libzmq
+    (which held the whole message before its first frame could be read: see zmq_guard).
     """
     frames = [first]
+    size = len(first)
     while sock.getsockopt(_RCVMORE):
+        if size > total:
+            sock.recv(copy=False)
+            continue
         frame = sock.recv()
+        size += len(frame)
         if len(frames) <= limit:
             frames.append(frame)
+    if size > total:
+        raise LimitExceeded(f"message of more than {total} bytes in its frames")
     return frames
 
 
-def recv_message(sock: zmq.Socket[bytes], flags: int = 0,
-                 limit: int = MAX_BLOBS + 1) -> list[bytes]:
+def recv_message(sock: zmq.Socket[bytes], flags: int = 0, limit: int = MAX_BLOBS + 1,
+                 total: int = MAX_MESSAGE) -> list[bytes]:
     """One whole message, as :func:`recv_rest` gives it. The first frame is taken as a
     ``zmq.Frame``, whose ``more`` flag answers what ``getsockopt(RCVMORE)`` would (that
     costs about 0.75 us in pyzmq, the Frame about 0.35 us): a one-frame message, the common
     case on a subscriber, asks the socket nothing more."""
     first = sock.recv(flags, copy=False)
     head = first.bytes
-    return recv_rest(sock, head, limit) if first.more else [head]
+    return recv_rest(sock, head, limit, total) if first.more else [head]
 
 
 def keepalive(sock: zmq.Socket[bytes], heartbeat: float, timeout: float) -> None:
@@ -157,10 +168,12 @@ def public(endpoint: str, location: str) -> str:
     return endpoint
 
 
-def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
-                     request: dict[str, Any], timeout: float,
-                     max_message: int = MAX_MESSAGE) -> dict[str, Any]:
-    """One-shot location-protocol request on a fresh socket (used for federation peers)."""
+def location_frame(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
+                   request: dict[str, Any], timeout: float,
+                   max_message: int = MAX_MESSAGE) -> bytes:
+    """One-shot location-protocol request on a fresh socket (used for federation peers):
+    the reply's first frame; TimeoutError when no reply of at most ``max_message`` bytes a
+    frame comes within ``timeout`` (ZeroMQ drops a larger one unread)."""
     sock = ctx.socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
     limit_input(sock, max_message)
@@ -168,11 +181,9 @@ def location_request(ctx: zmq.Context[zmq.Socket[bytes]], endpoint: str,
         sock.connect(endpoint)
         sock.send(json.dumps(request).encode())
         if not sock.poll(int(timeout * 1000), zmq.POLLIN):
-            raise RobosoaError(f"location service at {endpoint} did not answer")
-        try:
-            return load_object(sock.recv(), max_message)
-        except InvalidMessage as exc:
-            raise RobosoaError(f"location service at {endpoint} sent a bad reply: {exc}") from None
+            raise TimeoutError(f"location service at {endpoint} did not answer within "
+                               f"{timeout:g}s")
+        return sock.recv()
     finally:
         sock.close()
 

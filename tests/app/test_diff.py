@@ -318,7 +318,7 @@ class _Steps:
 
 def test_every_long_step_of_a_diff_and_a_scan_is_named(history: GitRepo) -> None:
     # not only parsing: reading each side, coupling each tree and comparing are named, so
-    # a long run never sits silent after the parsing bar ends (issue 16)
+    # a long run never sits silent after the parsing bar ends
     steps = _Steps()
     request = DiffRequest(history.root, "v1", "v2", load_settings(history.root), jobs=1)
     run_diff(request, steps, None)

@@ -105,7 +105,7 @@ def test_total_scales_come_from_total_sizes_not_from_location_sums() -> None:
 def test_to_dict_is_the_json_contract() -> None:
     s = location_summary(NEW)
     d = s.to_dict()
-    assert tuple(d) == SUMMARY_FIELDS
+    assert tuple(d) == (*SUMMARY_FIELDS, "unparsed")  # unparsed: set by the diff use case
     assert d["loc_scale"] is None and d["vg_scale"] is None
     assert isinstance(d["scaled_changes"], float) and isinstance(d["cost"], float)
     assert isinstance(d["changes"], int) and isinstance(d["notes"], list)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import shlex
+import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +42,8 @@ def test_the_workflow_uses_the_action_as_it_is_declared() -> None:
     used = set(re.findall(r"steps\.archmetrics\.outputs\.(\w+)", yaml.safe_dump(steps)))
     assert used and used <= set(action["outputs"])
     assert steps[0]["with"]["fetch-depth"] == 0
-    assert any("setup-python" in s.get("uses", "") for s in steps)
+    # the action sets Python up itself (action.yml's first step)
+    assert any("setup-python" in s.get("uses", "") for s in action["runs"]["steps"])
 
 
 def _scripts(node: Any) -> list[str]:
@@ -68,3 +70,15 @@ def test_the_commands_of_the_page_parse() -> None:
             build_parser().parse_args(argv)
         except SystemExit as error:
             pytest.fail(f"{command}: exit {error.code}")
+
+
+def test_no_page_pins_a_tag_that_does_not_exist() -> None:
+    """archmetrics has no release tags: the pages pin a commit (`@COMMIT`), never a `@v0.1.0`
+    a reader cannot fetch."""
+    tags = subprocess.run(
+        ["git", "-C", str(ROOT), "tag", "--list"], capture_output=True, text=True
+    ).stdout.split()
+    pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
+    for page in pages:
+        for tag in re.findall(r"archmetrics@(v[0-9][\w.]*)", page.read_text(encoding="utf-8")):
+            assert tag in tags, f"{page.name} pins {tag}, which is no tag of archmetrics"

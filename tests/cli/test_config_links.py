@@ -37,7 +37,7 @@ def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> Any:
 def test_a_folder_holding_only_router_rules_has_one_messaging_link(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The reproducer of docs/study.md's gap 2: before, "no source files to measure"."""
+    """The reproducer in docs/study.md, "Router rules": one route, one messaging link."""
     (tmp_path / "rules.toml").write_text(ONE_ROUTE)
     table = _run(capsys, "scan", "--by", "link", str(tmp_path), "--no-cache")
     row = next(line for line in table.splitlines() if "rules.toml:3" in line)

@@ -109,3 +109,76 @@ def test_hook_gates_the_range_pre_commit_is_given(repo: GitRepo, tmp_path: Path)
     ranged = run("--from-ref", base, "--to-ref", head)
     assert ranged.returncode == 1, ranged.stdout + ranged.stderr
     assert "gate failed: added > 3 (added(total) = 5)" in ranged.stdout + ranged.stderr
+
+
+def _hooked(repo: GitRepo, tmp_path: Path, gates: str) -> dict[str, str]:
+    """The repository configured to run this checkout's hook, and pre-commit's environment."""
+    repo.write(
+        {
+            ".pre-commit-config.yaml": f"repos:\n- repo: {ROOT}\n  rev: {_head()}\n"
+            "  hooks:\n  - id: archmetrics\n",
+            "archmetrics.toml": f"gates = [{gates}]\n",
+        }
+    )
+    return {
+        **os.environ,
+        **IDENTITY,
+        "PRE_COMMIT_HOME": str(ROOT / ".cache" / "pre-commit"),
+        "ARCHMETRICS_CACHE": str(tmp_path / "facts.sqlite3"),
+    }
+
+
+def _run(repo: GitRepo, env: dict[str, str], *argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        argv, cwd=repo.root, env=env, capture_output=True, text=True, timeout=900
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_hook_runs_on_deletions_and_configuration_changes(repo: GitRepo, tmp_path: Path) -> None:
+    """A commit that only deletes files, or only edits archmetrics.toml, is measured too (the
+    hook's file filter used to match nothing staged, and pre-commit skipped it)."""
+    env = _hooked(repo, tmp_path, '"removed > 3"')
+    repo.write({"a.py": "".join(f"v{i} = {i}\n" for i in range(5)), "b.py": "x = 1\n"})
+    assert _run(repo, env, str(PRE_COMMIT), "install").returncode == 0
+    repo.git("add", "-A")
+    first = _run(repo, env, "git", "commit", "-m", "first")
+    assert first.returncode == 0, first.stdout + first.stderr
+    repo.git("rm", "-q", "a.py")  # 5 statements removed, nothing else staged
+    deleted = _run(repo, env, "git", "commit", "-m", "delete a.py")
+    assert deleted.returncode != 0
+    assert "gate failed: removed > 3 (removed(total) = 5)" in deleted.stdout + deleted.stderr
+    repo.git("reset", "-q", "--hard")
+    repo.write({"archmetrics.toml": 'gates = ["removed > 3", "loc_post < 100"]\n'})
+    repo.git("add", "archmetrics.toml")
+    configured = _run(repo, env, "git", "commit", "-m", "a stricter gate, nothing else")
+    assert configured.returncode != 0  # the hook ran on a configuration-only commit
+    assert "gate failed: loc_post < 100" in configured.stdout + configured.stderr
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_all_files_fails_with_the_fix_and_a_range_counts_from_the_merge_base(
+    repo: GitRepo, tmp_path: Path
+) -> None:
+    """`pre-commit run --all-files` names no change: the hook says so instead of passing.
+    With --from-ref/--to-ref on a branch behind main, only the branch's changes count,
+    as pre-commit's own A...B file selection has it."""
+    env = _hooked(repo, tmp_path, '"removed > 0"')
+    repo.write({"a.py": "def f(a):\n    return a\n"})
+    repo.commit("base")
+    repo.git("checkout", "-q", "-b", "feature")
+    repo.commit("feature", files={"a.py": "def f(a):\n    if a:\n        return 1\n    return a\n"})
+    repo.git("checkout", "-q", "main")
+    repo.commit("main moves on", files={"b.py": "def g(b):\n    return b\n"})
+    repo.git("checkout", "-q", "feature")
+    every = _run(repo, env, str(PRE_COMMIT), "run", "archmetrics", "--all-files")
+    assert every.returncode == 1
+    assert "pre-commit ran the hook on files, not on a change" in every.stdout
+    assert "SKIP=archmetrics" in every.stdout
+    ranged = _run(
+        repo, env, str(PRE_COMMIT), "run", "archmetrics", "--from-ref", "main", "--to-ref", "HEAD"
+    )
+    assert ranged.returncode == 0, ranged.stdout + ranged.stderr  # main's b.py: not removed
+    assert "removed > 0" not in ranged.stdout

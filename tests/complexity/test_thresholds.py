@@ -27,13 +27,15 @@ def _failing(text: str) -> list[str]:
 
 @pytest.mark.parametrize(
     ("text", "failing"),
-    [
-        ("vg(function) > 10", ["branchy", "both"]),
-        ("vg(function) >= 12", ["branchy", "both"]),
+    [  # worst first: the furthest past the limit of its first failing condition, relative
+        # to the limit (both: (16 - 10) / 10 = 0.6 before branchy's 0.2)
+        ("vg(function) > 10", ["both", "branchy"]),
+        ("vg(function) >= 12", ["both", "branchy"]),
         ("loc(function) > 60 and vg(function) > 10", ["both"]),
-        ("loc(function) > 60 or vg(function) > 10", ["branchy", "long", "both"]),
-        # `and` binds tighter: small fails by the first group alone
-        ("vg(function) == 2 or loc(function) > 60 and vg(function) > 10", ["small", "both"]),
+        # long by loc (30 / 60 = 0.5), both by loc (20 / 60), branchy by vg (2 / 10)
+        ("loc(function) > 60 or vg(function) > 10", ["long", "both", "branchy"]),
+        # `and` binds tighter: small fails by the first group alone (==: 0 past its limit)
+        ("vg(function) == 2 or loc(function) > 60 and vg(function) > 10", ["both", "small"]),
         ("  vg ( function )<3  ", ["small"]),
         ("vg(function) != 2", ["branchy", "long", "both"]),
         ("vg(function) > 1e3", []),

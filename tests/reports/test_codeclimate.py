@@ -47,15 +47,16 @@ def test_a_scan_threshold_is_an_issue_at_its_function_or_file(
     assert [i["location"]["path"] for i in element] == ["src/m.py"]
 
 
-def test_a_failed_diff_gate_is_an_issue_of_the_repository(
+def test_a_failed_diff_gate_is_an_issue_at_the_file_the_change_touched_most(
     repo: GitRepo, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    repo.commit("one", tag="v1", files={"m.py": "x = 1\n"})
-    repo.commit("two", tag="v2", files={"m.py": "x = 1\n" + BRANCHY})
+    repo.commit("one", tag="v1", files={"m.py": "x = 1\n", "n.py": "y = 1\n"})
+    repo.commit("two", tag="v2", files={"m.py": "x = 1\n" + BRANCHY, "n.py": "y = 2\n"})
     argv = ["diff", "-C", str(repo.root), "--base", "v1", "--head", "v2"]
     [issue] = _issues(capsys, *argv, "--fail-on", "changes > 2", status=1)
-    assert issue["location"] == {"path": ".", "lines": {"begin": 1}}
+    assert issue["location"] == {"path": "m.py", "lines": {"begin": 1}}
     assert issue["description"].startswith("changes > 2 (changes(total) = ")
+    assert issue["description"].endswith("shown at the file it changed most)")
     assert _issues(capsys, *argv, "--fail-on", "changes > 100", status=0) == []
     staged = _issues(capsys, "series", "v1", "v2", "--repo", str(repo.root),
                      "--fail-on", "changes > 2", status=1)  # fmt: skip

@@ -109,6 +109,21 @@ def test_every_series_and_compare_document_holds_to_its_schema(
     assert not _validator("compare-1.schema.json").is_valid(compare)
 
 
+def test_a_history_validates_and_carries_the_diffs_definitions(
+    history: GitRepo, capsys: pytest.CaptureFixture[str]
+) -> None:
+    document = _document(capsys, "history", "-C", str(history.root), "--fail-on", "cost > 0")
+    assert len(document["commits"]) == 2 and document["commits"][1]["elements"]
+    validator = _validator("history-1.schema.json")
+    validator.validate(document)
+    diff = _schema("diff-1.schema.json")
+    copied = _schema("history-1.schema.json")["$defs"]
+    assert {k: copied[k] for k in diff["$defs"]} == diff["$defs"]
+    assert copied["commit"]["properties"]["locations"] == diff["properties"]["locations"]
+    document["commits"][0]["date"] = "yesterday"
+    assert not validator.is_valid(document)
+
+
 def test_a_stage_is_a_diff_document_in_every_schema() -> None:
     """series/1, compare/1 and study/2 carry diff/1's definitions, copied: they must not
     drift."""

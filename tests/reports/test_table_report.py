@@ -1,5 +1,5 @@
 """Tables that fit the terminal: names wrap and are never cut, numbers are never cut, and the
-columns left out on a narrow terminal are named (issue 16)."""
+columns left out on a narrow terminal are named."""
 
 from __future__ import annotations
 

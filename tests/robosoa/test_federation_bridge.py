@@ -21,7 +21,7 @@ def two_urls(request: pytest.FixtureRequest) -> Iterator[tuple[str, str]]:
     if request.param == "inproc":
         yield f"inproc://fed-a-{uuid.uuid4().hex[:6]}", f"inproc://fed-b-{uuid.uuid4().hex[:6]}"
         return
-    (one, first), (two, second) = tcp_location(), tcp_location()
+    (one, first), (two, second) = tcp_location("--accept-federate"), tcp_location()
     yield first, second
     one.stop()
     two.stop()

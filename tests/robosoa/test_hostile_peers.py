@@ -267,7 +267,8 @@ def test_thirty_silent_federation_peers_cost_one_deadline(ctx: zmq.Context[zmq.S
     for sock in silent:
         sock.setsockopt(zmq.LINGER, 0)
         addresses.append(f"tcp://127.0.0.1:{sock.bind_to_random_port('tcp://127.0.0.1')}")
-    proc, url = tcp_location(*(a for address in addresses for a in ("--federate", address)))
+    proc, url = tcp_location("--accept-federate",
+                             *(a for address in addresses for a in ("--federate", address)))
     try:
         start = time.monotonic()
         reply = location_call(ctx, url, {"op": "lookup", "name": f"x-{uuid.uuid4().hex}"})

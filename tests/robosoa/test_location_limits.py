@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 import time
 
@@ -16,6 +18,7 @@ from robosoa.location import (
     RegistryFull,
     ServiceInfo,
 )
+from robosoa.transports.zmq_federation import encode_reply
 
 
 def entry(instance: str, ttl: object = 0.0, **extra: object) -> dict[str, object]:
@@ -134,3 +137,25 @@ def test_peers_that_miss_the_deadline_are_backed_off() -> None:
     start = time.monotonic()
     assert service.lookup("a") == [] and service.lookup("b") == []
     assert time.monotonic() - start < 1.0 and calls == ["a"]
+
+
+def test_an_entry_as_a_dict_has_every_field() -> None:
+    info = ServiceInfo.from_dict(entry("a", 2.5, group="g", idempotent=["op"], pid=7))
+    expected = dataclasses.asdict(info) | {"operations": ["op"], "idempotent": ["op"]}
+    assert info.to_dict() == expected
+    assert list(info.to_dict()) == [f.name for f in dataclasses.fields(ServiceInfo)]
+    assert ServiceInfo.from_dict(info.to_dict()) == info
+
+
+def test_a_lookup_reply_is_cut_to_its_limit() -> None:
+    services = [ServiceInfo.from_dict(entry(f"i{n}", pid=n)).to_dict() for n in range(100)]
+    whole, left = encode_reply({"services": services}, 7, 10**6)
+    assert left == 0 and json.loads(whole) == {"services": services, "rid": 7}
+    for limit in (len(whole) - 1, len(whole) // 2, 300):
+        frame, left = encode_reply({"services": services}, 7, limit)
+        data = json.loads(frame)
+        assert len(frame) <= limit and 0 < left == data["truncated"]
+        assert data["services"] == services[: 100 - left] and data["rid"] == 7
+    past_64_bits, _ = encode_reply({"services": [{"pid": 10**30}]}, 10**40, 1000)
+    assert json.loads(past_64_bits) == {"services": [{"pid": 10**30}], "rid": 10**40}
+    assert json.loads(encode_reply({"error": "no"}, "r", 1000)[0]) == {"error": "no", "rid": "r"}

@@ -248,3 +248,32 @@ def test_the_printed_table_keeps_the_elements_a_cause_names(
                  "--quiet"]) == 0  # fmt: skip
     printed = capsys.readouterr().out
     assert "idiomatic disagrees" in printed and "[p2d_service/*.py," in printed
+
+
+def test_the_figures_docs_ci_quotes_are_the_study_s(report: Any) -> None:
+    """docs/ci.md ("Choosing gates") explains E with the study's own numbers: each quoted
+    figure is on the page and is what replicate measures."""
+    page = (Path(__file__).resolve().parents[2] / "docs" / "ci.md").read_text("utf-8")
+    page = " ".join(page.split())  # the page wraps its lines anywhere
+    new = {stage: _total(report, "wdb", "soa", stage, "new") for stage in ("first", "second")}
+    quoted = [
+        (new["first"]["scaled_changes"], "Γ' = 27.44"),
+        (new["first"]["scaled_delta_vg"], "ΔVg' = 14.76"),
+        (new["first"]["cost"], "E = 1.86"),
+        (new["second"]["scaled_changes"], "Γ' = 22.25"),
+        (new["second"]["scaled_delta_vg"], "ΔVg' = 3.29"),
+        (new["second"]["cost"], "E = 6.76"),
+    ]
+    assert new["second"]["delta_vg"] == 3
+    totals = {a: _total(report, "wdb", a, "first", "total") for a in ("soa", "player", "p2p")}
+    quoted += [(totals[a]["cost"], f"{e} ({name})")
+               for a, e, name in (("soa", "2.22", "SOA"), ("player", "2.31", "Player"),
+                                  ("p2p", "3.32", "P2P"))]  # fmt: skip
+    quoted += [(totals[a]["scaled_changes"], f) for a, f in (("soa", "26.27"),
+               ("player", "35.17"), ("p2p", "174.38"))]  # fmt: skip
+    for value, text in quoted:
+        assert text in page, text
+        assert f"{value:.2f}" in text, (value, text)
+    for location in ("base", "framework"):
+        first = _total(report, "wdb", "soa", "first", location)
+        assert (first["changes"], first["delta_vg"], first["cost"]) == (1, 0, 0.0)
