@@ -64,8 +64,9 @@ class ConfigurationFiles:
     """A path's configuration format, by the ``files`` globs of the packs' configuration
     rules (the first rule, in load order, that names the path decides), or None: which files
     a scan or diff reads as configuration (docs/metrics.md, "Configuration links"). A rule
-    with ``within`` (``package.xml``) names only files inside a folder holding that file:
-    :meth:`in_tree` says which folders those are, from the tree's paths; until then such
+    with ``within`` (``package.xml``) names files only in a tree holding that file (a ROS
+    workspace; a launch file or plugin description need not sit in a package of its own):
+    :meth:`in_tree` says which folders hold it, from the tree's paths; until then such
     rules name nothing."""
 
     def __init__(self, packs: RuleSet) -> None:
@@ -103,16 +104,8 @@ class ConfigurationFiles:
         return None
 
     def _inside(self, path: str, marker: str) -> bool:
-        folders = self.folders.get(marker)
-        if not folders:
-            return False
-        folder = path.rpartition("/")[0]
-        while True:
-            if folder in folders:
-                return True
-            if not folder:
-                return False
-            folder = folder.rpartition("/")[0]
+        """Whether the tree of ``path`` holds ``marker`` (in any folder)."""
+        return bool(self.folders.get(marker))
 
 
 def configuration_files(packs: RuleSet) -> ConfigurationFiles:

@@ -60,6 +60,25 @@ def _interpreted(facts: FileFacts, rules: Sequence[ConfigRule]) -> list[LinkSite
                 callee = "composable_node" if entry.plugin else "node"
                 found.append(LinkSite(facts.path, entry.line, rule.qualified_id, rule.kind,
                                       rule.role, callee, point, LinkStatus.UNRESOLVED))  # fmt: skip
+        elif rule.interpret == "pluginlib":
+            found.extend(_described(facts, rule))
+    return found
+
+
+def _described(facts: FileFacts, rule: ConfigRule) -> list[LinkSite]:
+    """A plugin description's classes (``<library><class name=... type=...>``): one site
+    each, its endpoint the C++ class (``type``) as the loads of its lookup name (``name``,
+    kept as the endpoint's text) resolve to it, receiving them."""
+    found = []
+    for table in facts.tables:
+        if table.keys[-1:] != ("class",) or table.keys[0] not in ("library", "class_libraries"):
+            continue
+        kind = (table.get("type") or table.get("name") or ("",))[0]
+        lookup = (table.get("name") or table.get("type") or ("",))[0]
+        if kind:
+            point = Endpoint(f"plugin:{kind}", lookup, "configuration")
+            found.append(LinkSite(facts.path, table.line, rule.qualified_id, rule.kind,
+                                  rule.role, "class", point, LinkStatus.UNRESOLVED))  # fmt: skip
     return found
 
 

@@ -24,6 +24,7 @@ from archmetrics.coupling.graphnames import (
     graph_endpoint,
     imported_names,
     qualified,
+    through_alias,
 )
 from archmetrics.coupling.matching import (
     Requirements,
@@ -210,6 +211,10 @@ def file_link_sites(
         if rule is None and context is not None and context.imports:  # as imported
             named = qualified(callee, context.imports)
             rule = calls.choose(named, receiver in modules) if named != callee else None
+        elif rule is None and context is not None and context.aliases is not None:
+            aliased = through_alias(call, context.aliases)  # made through a type alias
+            rule = calls.choose(aliased.callee) if aliased is not None else None
+            call = aliased if rule is not None and aliased is not None else call
         if rule and not (rule.unless_from and _assigned_from(facts, call, rule.unless_from)):
             if _bare(call, rule):
                 continue
@@ -228,7 +233,7 @@ def file_link_sites(
             found.append(Found(rule, replace(site, note=note), None))
     pairs = [(f.rule, f.site) for f in found]
     found = [Found(f.rule, _from_file(f.rule, f.site, pairs), f.call) for f in found]
-    found = [_fallback(f, context) for f in bound_to_makers(found)]
+    found = [_fallback(f, context) for f in bound_to_makers(found, facts)]
     return tuple(sorted((f.site for f in found), key=lambda s: (s.line, s.rule)))
 
 
@@ -252,6 +257,8 @@ def _call_site(
     if spec is None or context is None or not (spec.naming or spec.value or spec.data_type):
         return site
     kind = data_type(call, spec.data_type, context.imports, spec.naming == "ros1", context.aliases)
+    if spec.naming == "ros1" and spec.type == "action":  # actionlib's MoveBaseAction
+        kind = kind.removesuffix("Action")  # is the action move_base_msgs/MoveBase
     if spec.created_by and endpoint is None:
         return replace(site, data_type=kind)  # its maker gives it (receivers.py)
     parameter = endpoint.via.partition(":")[2] if endpoint and endpoint.via.startswith(

@@ -32,6 +32,7 @@ from archmetrics.coupling.rules import EndpointSpec, Place
 from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.values import pick
 from archmetrics.facts import Binding, CallSite, Dependency
+from archmetrics.parsers.c_family_calls import template_arguments, without_template_arguments
 
 _TYPE_NAME = re.compile(r"[A-Za-z_]\w*(?:::[A-Za-z_]\w*)*(?:<.*>)?")
 
@@ -87,6 +88,22 @@ class TypeAliases:
         if given is None:
             return None
         return given.get(function) or given.get(None)
+
+
+def through_alias(call: CallSite, aliases: TypeAliases | None) -> CallSite | None:
+    """``call`` as made through the type alias its callee names (``MoveServer server(nh,
+    "move_base")`` after ``typedef actionlib::SimpleActionServer<T> MoveServer;``): its
+    callee the aliased class, its template arguments the alias's; None when it names none."""
+    if aliases is None or call.receiver is not None or call.templates:
+        return None
+    given = aliases.get(call.callee, call.function)
+    if given is None or given == call.callee:
+        return None
+    return call._replace(
+        callee=without_template_arguments(given),
+        name=without_template_arguments(given).rpartition("::")[2],
+        templates=template_arguments(given) if "<" in given else (),
+    )
 
 
 def data_type(

@@ -104,7 +104,9 @@ class LinkSite:
     note: str = ""  # why the endpoint is unknown, when it is known why (several values ...)
     # a graph name (ROS): the name as read, before it is resolved against its node
     name: str = ""
-    node: str = ""  # the node the site is made in, as the code names it (/ns/talker)
+    # the node the site is made in, as the code names it (/ns/talker); of a launch file's
+    # entry: the node it starts
+    node: str = ""
     data_type: str = ""  # the message, service or action type (geometry_msgs/msg/Twist)
     parameter: str = ""  # the parameter whose default gave the name ("" if none)
 

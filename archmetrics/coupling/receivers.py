@@ -6,7 +6,10 @@ create_publisher<T>("cmd_vel", 10)`` said, ``self.cli.call_async(req)`` calls th
 The object is matched by name (``this->pub_`` and ``pub_`` are one member) among the file's
 link sites whose call's value was assigned to it (facts.CallSite.target), preferring a
 making call in the same class; two makers with different endpoints leave the site unknown,
-its note listing them.
+its note listing them. A call whose object no link site made is no site when the file
+shows the object is something else: it is assigned from the construction of a class
+(``self.client = mqtt.Client()``), or a class of the file other than the caller's defines
+the method (``EventBus::publish``: an in-process bus sharing ROS's verbs).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from archmetrics.coupling.model import LinkSite
 from archmetrics.coupling.rules import Rule
 from archmetrics.coupling.scopes import owner, receiver_of
 from archmetrics.coupling.trace import member
-from archmetrics.facts import CallSite
+from archmetrics.facts import CallSite, FileFacts
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,7 +52,46 @@ def _makers(found: Found, everything: Sequence[Found]) -> list[Found]:
     return same_class or makers
 
 
-def bound_to_makers(found: Sequence[Found]) -> list[Found]:
+def _wrapped(found: Found, everything: Sequence[Found], facts: FileFacts) -> list[Found]:
+    """The makers of the object a wrapper made by ``created_by`` was given: a realtime
+    publisher ``rt_ = std::make_shared<RealtimePublisher<T>>(pub_)`` publishes where
+    ``pub_`` was made to (the wrapper itself is no site)."""
+    spec = found.rule.endpoint
+    receiver = receiver_of(found.call) if found.call is not None else None
+    if spec is None or receiver is None:
+        return []
+    inner = {
+        member(call.arguments[0].text.removeprefix("std::move(").rstrip(")"))
+        for call in facts.call_sites
+        if call.target is not None and member(call.target) == receiver and call.arguments
+        and any(matches(p, constructed(call)[0]) for p in spec.created_by)
+    }  # fmt: skip
+    return [
+        other
+        for other in everything
+        if other.call is not None and other.call.target is not None
+        and member(other.call.target) in inner
+    ]  # fmt: skip
+
+
+def _other_object(call: CallSite, receiver: str, facts: FileFacts) -> bool:
+    """Whether ``facts`` show the object ``receiver`` names is no ROS object (module doc)."""
+    for other in facts.call_sites:
+        if other.target is not None and member(other.target) == receiver:
+            last = other.callee.replace("::", ".").rpartition(".")[2]
+            if last[:1].isupper() and "<" not in other.callee:
+                return True  # made by a class no rule names (a maker would have a site)
+    mine = owner(call.function)
+    for function in facts.functions:
+        name = function.qualified_name
+        if name.endswith(("::" + call.name, "." + call.name)):
+            defined = owner(name)
+            if defined and defined != mine:
+                return True
+    return False
+
+
+def bound_to_makers(found: Sequence[Found], facts: FileFacts | None = None) -> list[Found]:
     """Each site of ``found`` whose rule says ``created_by`` and that has no endpoint of its
     own, given the endpoint, name, node, data type and parameter of its object's maker; a
     site whose rule says ``created_only`` and whose object no call of the file made is left
@@ -64,8 +106,15 @@ def bound_to_makers(found: Sequence[Found]) -> list[Found]:
         if receiver in (None, "this", "self", "(*this)"):
             continue  # a method of the class itself (this->publish()): no object made
         makers = _makers(item, found)
+        if not makers and facts is not None:
+            makers = _wrapped(item, found, facts)
         if not makers and spec.created_only:
             continue  # no object this file makes: no link (``subprocess.call``)
+        if (
+            not makers and item.call is not None and facts is not None and receiver is not None
+            and _other_object(item.call, receiver, facts)
+        ):
+            continue  # fmt: skip
         points = {m.site.endpoint.key for m in makers if m.site.endpoint is not None}
         site = item.site
         if len(points) > 1:

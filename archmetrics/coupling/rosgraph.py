@@ -179,8 +179,10 @@ def _applied(
     elif site.endpoint is not None and site.role is Role.INITIATE and _type(site) == "plugin":
         lookup = site.endpoint.key.partition(":")[2]  # a lookup name: the class it names
         if lookup in tree.aliases:
-            site = replace(
-                site, endpoint=replace(site.endpoint, key=f"plugin:{tree.aliases[lookup]}")
+            site = replace(  # the lookup name as read is kept as the site's name
+                site,
+                endpoint=replace(site.endpoint, key=f"plugin:{tree.aliases[lookup]}"),
+                name=site.name or f"plugin:{lookup}",
             )
     if site.endpoint is not None and site.role is Role.INITIATE:
         _receivers_of(site, tree, receivers, element_of)
@@ -199,7 +201,7 @@ def _launch_site(
         started = {element for element, entries in starts.items() if entry in entries}
         if started:
             receivers.setdefault(key, set()).update(started)
-    return replace(site, endpoint=point, note="")
+    return replace(site, endpoint=point, note="", node=entry.full_name)
 
 
 def _renamed(site: LinkSite, tree: RosTree, configuration: _Configuration) -> LinkSite:

@@ -44,6 +44,15 @@ class Launched:
     known: bool = True  # False: some remapping or namespace was computed, not written
 
     @property
+    def full_name(self) -> str:
+        """The node's name as ROS gives it (``/robot1/talker``): its ``name``, else its
+        executable's, under its namespace; "" when neither is written."""
+        name = self.name or ("" if self.plugin else self.executable.rpartition("/")[2])
+        if not name or name.startswith("/"):
+            return name
+        return "/" + "/".join(p for p in (*self.namespace.split("/"), name) if p)
+
+    @property
     def key(self) -> str:
         """The endpoint of the launch site: ``node:pkg/exec`` or ``plugin:Class``."""
         if self.plugin:

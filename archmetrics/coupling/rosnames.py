@@ -84,8 +84,9 @@ _ADAPTER = re.compile(r"(?:rclcpp::)?(?:TypeAdapter<.*,|adapt_type<.*>::as<)([\w
 def interface_type(written: str) -> str:
     """A message, service or action type as ROS's tools write it: ``pkg/msg/Name``
     (``geometry_msgs::msg::Twist``, ``geometry_msgs.msg.Twist``, ``std_msgs::String``); a
-    type adapter by the ROS type it adapts to."""
-    text = _TYPE_NOISE.sub("", written.strip()).lstrip(":")
+    type adapter by the ROS type it adapts to; one named in a string (a generic publisher's
+    ``"std_msgs/msg/String"``) without its quotes."""
+    text = _TYPE_NOISE.sub("", written.strip().strip("\"'")).lstrip(":")
     adapted = _ADAPTER.fullmatch(text)  # rclcpp::TypeAdapter<std::string, pkg::msg::T>
     if adapted:
         text = adapted.group(1)

@@ -90,7 +90,7 @@ def config_row(rule: ConfigRule) -> RuleRow:
         match = f"{', '.join(rule.files)}: read as {rule.interpret}"
     match += f" where {when}" if when else ""
     match += f" (default {defaults})" if defaults else ""
-    match += f" (inside a folder with {rule.within})" if rule.within else ""
+    match += f" (in a tree with {rule.within})" if rule.within else ""
     pattern = f" ~ {rule.endpoint.pattern}" if rule.endpoint.pattern else ""
     return RuleRow(
         pack=rule.pack,
