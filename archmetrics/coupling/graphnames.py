@@ -31,9 +31,11 @@ from archmetrics.coupling.rosnames import (
 from archmetrics.coupling.rules import EndpointSpec, Place
 from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.values import pick
-from archmetrics.facts import Binding, CallSite, Dependency
+from archmetrics.facts import Binding, CallSite, Dependency, Statement
 from archmetrics.parsers.c_family_calls import template_arguments, without_template_arguments
 
+_SHARED = re.compile(r"(?:boost|std)::shared_ptr<(.+)>")
+_CALLBACK_SUFFIX = re.compile(r"(?:::ConstPtr|::Ptr|ConstPtr|::Request|::Response)$")
 _TYPE_NAME = re.compile(r"[A-Za-z_]\w*(?:::[A-Za-z_]\w*)*(?:<.*>)?")
 
 
@@ -66,13 +68,36 @@ def qualified(callee: str, imports: Mapping[str, str]) -> str:
 class TypeAliases:
     """A C++ file's type aliases, read from its bindings when first asked: each name with
     the types it is given, in the function that gives it (None: at file, namespace or class
-    level). Only a binding whose value is a plain (qualified) name is an alias."""
+    level). Only a binding whose value is a plain (qualified) name is an alias. And its
+    functions' signatures (``function`` statements), for the type a callback takes."""
 
-    __slots__ = ("_bindings", "_found")
+    __slots__ = ("_bindings", "_found", "_statements")
 
-    def __init__(self, bindings: Sequence[Binding]) -> None:
+    def __init__(self, bindings: Sequence[Binding], statements: Sequence[Statement] = ()) -> None:
         self._bindings = bindings
+        self._statements = statements
         self._found: dict[str, dict[str | None, str]] | None = None
+
+    def parameter_type(self, callback: str) -> str | None:
+        """The type of the first parameter of the function ``callback`` names (``onScan``,
+        ``&Node::onScan``) as written, without its reference, ``ConstPtr`` or ``Request``;
+        None when the file defines no such function."""
+        name = callback.replace(" ", "").lstrip("&").rpartition("::")[2]
+        if not name.isidentifier():
+            return None
+        heads = [s.text for s in self._statements if s.kind == "function" and s.function
+                 and (s.function == name or s.function.endswith("::" + name))]  # fmt: skip
+        if len(heads) != 1 or "(" not in heads[0]:
+            return None
+        first = heads[0].partition("(")[2].rpartition(")")[0].split(",")[0].split("=")[0]
+        first = re.sub(r"\s*([:<>])\s*", r"\1", re.sub(r"\bconst\b", " ", first))
+        words = first.replace("&", " ").replace("*", " ").split()
+        if len(words) > 1 and words[-1].isidentifier():
+            words = words[:-1]  # the parameter's name
+        written = "".join(words)
+        inner = _SHARED.fullmatch(written)
+        written = inner.group(1) if inner else written
+        return _CALLBACK_SUFFIX.sub("", written) or None
 
     def get(self, name: str, function: str | None) -> str | None:
         """The type ``name`` stands for in ``function``: its alias there, else one given
@@ -136,9 +161,13 @@ def _data_type(
     if place.template is not None:
         _, templates = constructed(call)
         written = templates[place.template] if place.template < len(templates) else None
-    else:
+    elif place.arg is not None or place.keyword is not None:
         argument = pick(call.arguments, place)
         written = argument.text if argument is not None else None
+    if not written and place.callback is not None and aliases is not None:
+        positional = [a for a in call.arguments if a.keyword is None]
+        if place.callback < len(positional):
+            written = aliases.parameter_type(positional[place.callback].text)
     if not written:
         return ""
     written = written.replace(" ", "")

@@ -217,7 +217,8 @@ class Sites:
         if self.rules.scopes or self.rules.values:
             scopes = FileScopes(facts, self.rules.scopes, seen_, tracer.read)
             imports = imported_names(facts.dependencies) if python else {}
-            aliases = TypeAliases(facts.bindings) if facts.language in _C_FAMILY else None
+            c_family = facts.language in _C_FAMILY
+            aliases = TypeAliases(facts.bindings, facts.statements) if c_family else None
             context = FileContext(scopes, imports, aliases)
         return file_link_sites(facts, self.rules, seen_, tracer.read, modules, context)
 

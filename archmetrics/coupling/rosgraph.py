@@ -172,7 +172,7 @@ def _applied(
     starts: Mapping[str, list[Launched]],
 ) -> LinkSite:
     entry = by_launch.get((site.path, site.line))
-    if entry is not None and _type(site) in ("node", "plugin"):
+    if entry is not None and (_type(site) in ("node", "plugin") or site.kind == "config"):
         site = _launch_site(site, entry, tree, receivers, starts)
     elif site.name:
         site = _renamed(site, tree, configuration)

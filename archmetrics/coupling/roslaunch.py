@@ -24,7 +24,16 @@ from archmetrics.coupling.matching import matches, requirement_met
 from archmetrics.facts import CallSite, ConfigTable, FileFacts, Language
 
 _PUSHES = (("push-ros-namespace",), ("push_ros_namespace",))
-NODE_CALLS = ("launch_ros.actions.Node", "actions.Node")
+NODE_CALLS = (
+    "launch_ros.actions.Node", "actions.Node",
+    "launch_ros.actions.ComposableNodeContainer", "actions.ComposableNodeContainer",
+)  # fmt: skip
+GROUP_CALLS = ("launch.actions.GroupAction", "actions.GroupAction")
+PUSH_CALLS = ("launch_ros.actions.PushRosNamespace", "actions.PushRosNamespace",
+              "launch_ros.actions.PushROSNamespace", "actions.PushROSNamespace")  # fmt: skip
+ARGUMENT_CALLS = ("launch.actions.DeclareLaunchArgument", "actions.DeclareLaunchArgument")
+# ExecuteProcess(cmd=["ros2", "run", pkg, executable]) starts that node
+PROCESS_CALLS = ("launch.actions.ExecuteProcess", "actions.ExecuteProcess")
 COMPONENT_CALLS = ("launch_ros.descriptions.ComposableNode", "descriptions.ComposableNode")
 
 
@@ -125,6 +134,10 @@ def python_launched(facts: FileFacts) -> Iterator[Launched]:
     for call in facts.call_sites:
         callee = qualified(call.callee, imports)
         component = any(matches(p, callee) for p in COMPONENT_CALLS)
+        if any(matches(p, callee) for p in PROCESS_CALLS):
+            if (process := _ros2_run(facts, call)) is not None:
+                yield process
+            continue
         if not component and not any(matches(p, callee) for p in NODE_CALLS):
             continue
         text = {
@@ -139,6 +152,9 @@ def python_launched(facts: FileFacts) -> Iterator[Launched]:
         remaps, readable = _pairs(text["remappings"])
         written = _keyword(call, ("remappings",)) is None or readable
         namespace = text["namespace"]
+        pushed = _pushed(facts, call, imports)
+        if pushed and namespace is None and _keyword(call, ("namespace",)) is None:
+            namespace = pushed
         yield Launched(
             facts.path, call.span.start, _text(text["package"]),
             executable="" if component else _text(text["executable"]),
@@ -147,6 +163,64 @@ def python_launched(facts: FileFacts) -> Iterator[Launched]:
             parameters=_parameters(text["parameters"]),
             known=written and (namespace is not None or _keyword(call, ("namespace",)) is None),
         )  # fmt: skip
+
+
+def _pushed(facts: FileFacts, call: CallSite, imports: Mapping[str, str]) -> str | None:
+    """The namespace a ``PushRosNamespace`` before ``call`` in the innermost ``GroupAction``
+    around it pushes: a literal, or a ``LaunchConfiguration`` by its launch argument's
+    ``default_value``; None when none is pushed or it is computed."""
+    calls = [(qualified(c.callee, imports), c) for c in facts.call_sites]
+    groups = [c for name, c in calls if _any(GROUP_CALLS, name) and c.span.start <= call.span.start
+              and call.span.end <= c.span.end and c is not call]  # fmt: skip
+    if not groups:
+        return None
+    group = max(groups, key=lambda c: c.span.start)
+    pushes = [c for name, c in calls if _any(PUSH_CALLS, name) and c.arguments
+              and group.span.start <= c.span.start <= call.span.start]  # fmt: skip
+    if not pushes:
+        return None
+    written = pushes[-1].arguments[0].text
+    value = _named(facts, call, written)
+    if isinstance(value, str):
+        return value
+    configuration = next(
+        (b.value for b in facts.bindings if b.name == written and b.function == call.function),
+        written,
+    )  # robot = LaunchConfiguration('robot')
+    argument = _configuration_name(configuration)
+    for name, other in calls:
+        if (
+            _any(ARGUMENT_CALLS, name) and other.arguments
+            and python_value(other.arguments[0].text) == argument
+        ):  # fmt: skip
+            default = _named(facts, other, _keyword(other, ("default_value",)))
+            return default if isinstance(default, str) else None
+    return None
+
+
+def _any(patterns: Sequence[str], callee: str) -> bool:
+    return any(matches(p, callee) for p in patterns)
+
+
+def _configuration_name(text: str) -> str | None:
+    """``x`` of ``LaunchConfiguration('x')`` as written; None for anything else."""
+    head, _, rest = text.replace(" ", "").partition("(")
+    if not head.endswith("LaunchConfiguration") or not rest.endswith(")"):
+        return None
+    value = python_value(rest[:-1].split(",")[0])
+    return value if isinstance(value, str) else None
+
+
+def _ros2_run(facts: FileFacts, call: CallSite) -> Launched | None:
+    """``ExecuteProcess(cmd=["ros2", "run", pkg, executable, ...])``: that node, named after
+    its executable; None for any other command."""
+    cmd = _named(facts, call, _keyword(call, ("cmd",)))
+    if not isinstance(cmd, list | tuple) or len(cmd) < 4 or list(cmd[:2]) != ["ros2", "run"]:
+        return None
+    package, executable = cmd[2], cmd[3]
+    if not isinstance(package, str) or not isinstance(executable, str):
+        return None
+    return Launched(facts.path, call.span.start, package, executable=executable)
 
 
 def _text(value: object) -> str:

@@ -83,12 +83,15 @@ class FunctionHint:
 @dataclass(frozen=True, slots=True)
 class Place:
     """Where a value is at a call: a template argument of the callee (C++), a positional
-    argument, a keyword argument (tried first), or a fixed ``value``."""
+    argument, a keyword argument (tried first), or a fixed ``value``; ``callback`` (C++, a
+    data type): else the type of the first parameter of the file's function the positional
+    argument at that index names (ROS 1's ``nh.subscribe("scan", 10, onScan)``)."""
 
     template: int | None = None
     arg: int | None = None
     keyword: str | None = None
     value: str | None = None
+    callback: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

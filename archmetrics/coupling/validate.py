@@ -35,7 +35,7 @@ _ENDPOINT_KEYS = frozenset(
     {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file", "value",
      "created_by", "naming", "data_type", "created_only"}
 )  # fmt: skip
-_PLACE_KEYS = frozenset({"template", "arg", "keyword", "value"})
+_PLACE_KEYS = frozenset({"template", "arg", "keyword", "value", "callback"})
 _HINT_KEYS = frozenset({"match", "arg", "keyword"})
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 
@@ -264,6 +264,7 @@ def parse_place(where: Where, raw: object, key: str) -> Place:
             arg=where.integer(table, "arg"),
             keyword=where.text(table, "keyword", "") or None,
             value=where.text(table, "value", "") or None,
+            callback=where.integer(table, "callback"),
         )
     except RulePackError as error:
         raise RulePackError(error.source, error.rule, f"{key}.{error.key}", error.problem) from None
@@ -271,6 +272,8 @@ def parse_place(where: Where, raw: object, key: str) -> Place:
         where.fail(key, "says nowhere: give template, arg, keyword or value")
     if place.template is not None and place.template < 0:
         where.fail(f"{key}.template", "template argument index must be >= 0")
+    if place.callback is not None and place.callback < 0:
+        where.fail(f"{key}.callback", "argument index must be >= 0")
     return place
 
 

@@ -72,6 +72,8 @@ _RULE_KINDS: dict[str, str] = {
     **dict.fromkeys(("get-parameter", "parameter", "py-parameter", "parameter-file"),
                     "param-get"),
     **dict.fromkeys(("set-parameter", "py-set-parameter"), "param-set"),
+    "parameters-client": "param-client", "transport-hints": "param-get", "remote-parameters": "param-remote",
+    "parameter-events": "param-events",
     "plugin-export": "plugin-export", "component": "component-register",
     "plugin-load": "plugin-load", "plugin-description": "plugin-description",
     **dict.fromkeys(("launch-node", "launch-file", "launch-file-yaml"), "launch-node"),
@@ -112,12 +114,15 @@ def ros_endpoint(site: Mapping[str, object]) -> tuple[str, str | None, str | Non
         if str(endpoint).startswith("plugin:"):
             kind = "launch-component"
         return kind, str(site["node"]) if site.get("node") else None, None
-    if pack == "ros2" and KIND_CATEGORY.get(kind) == "parameter" and site.get("endpoint_name"):
+    own = ("param-declare", "param-get", "param-set")  # a node's own parameter, as declared
+    if pack == "ros2" and kind in own and site.get("endpoint_name"):
         endpoint = str(site["endpoint_name"]).replace(":~/", ":", 1)
     if kind == "plugin-description" and site.get("endpoint_text"):
         endpoint = f"plugin:{site['endpoint_text']}"  # its lookup name, as the oracle names it
     elif KIND_CATEGORY.get(kind) == "plugin" and site.get("endpoint_name"):
         endpoint = site["endpoint_name"]  # a pluginlib lookup name, as the oracle names it
+    if kind == "param-remote" and endpoint:  # the node's parameter service the call names
+        endpoint = f"{endpoint}/{str(site.get('callee', '')).rpartition('>')[2].rpartition('.')[2]}"
     named = endpoint and site.get("status") != "unresolved"
     name = _SCHEME.sub("", str(endpoint), count=1) if named else None
     written = _SCHEME.sub("", str(site.get("endpoint_name") or ""), count=1)
