@@ -39,7 +39,7 @@ from archmetrics.coupling.matching import (
 )
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
 from archmetrics.coupling.patterns import SlowPattern, search
-from archmetrics.coupling.receivers import Found, bound_to_makers
+from archmetrics.coupling.receivers import Found, bound_to_makers, invoked
 from archmetrics.coupling.rules import (
     EndpointSource,
     EndpointSpec,
@@ -50,7 +50,7 @@ from archmetrics.coupling.rules import (
     SiteKind,
 )
 from archmetrics.coupling.scopes import FileScopes
-from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader
+from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader, member
 from archmetrics.facts import Argument, CallSite, FileFacts, Language
 
 __all__ = [
@@ -219,6 +219,10 @@ def file_link_sites(
             if _bare(call, rule):
                 continue
             found.append(Found(rule, _call_site(facts, call, rule, read, context), call))
+    made = {member(f.call.target) for f in found if f.call is not None and f.call.target}
+    for call in readable if made else ():
+        if (called := invoked(call, made)) and (rule := calls.choose(called.callee)):
+            found.append(Found(rule, _call_site(facts, called, rule, read, context), called))
     definitions = rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION))
     for function in facts.functions:
         if rule := definitions.choose(function.qualified_name):

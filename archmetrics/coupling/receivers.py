@@ -91,6 +91,15 @@ def _other_object(call: CallSite, receiver: str, facts: FileFacts) -> bool:
     return False
 
 
+def invoked(call: CallSite, made: set[str]) -> CallSite | None:
+    """A call of an object itself (``add_two_ints(x, y)`` on a ``rospy.ServiceProxy``) as
+    the method call rules name it, ``add_two_ints.__call__``; None when ``call`` calls no
+    object a link site of the file made (``made``: their targets)."""
+    if call.receiver not in (None, "self", "this") or member(call.callee) not in made:
+        return None
+    return call._replace(callee=f"{call.callee}.__call__", name="__call__", receiver=call.callee)
+
+
 def bound_to_makers(found: Sequence[Found], facts: FileFacts | None = None) -> list[Found]:
     """Each site of ``found`` whose rule says ``created_by`` and that has no endpoint of its
     own, given the endpoint, name, node, data type and parameter of its object's maker; a
