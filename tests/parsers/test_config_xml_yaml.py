@@ -70,8 +70,10 @@ def test_xml_entities_are_never_expanded_nor_fetched() -> None:
     external = (
         '<?xml version="1.0"?><!DOCTYPE x [<!ENTITY e SYSTEM "file:///etc/passwd">]><x>&e;</x>'
     )
-    (root,) = config_xml.parse("x.xml", external).tables
-    assert root == ConfigTable(("x",), 1, (), -1)  # the entity is left as it was: no text read
+    refused = config_xml.parse("x.xml", external)  # refused before anything is opened
+    assert not refused.parsed and "declares an entity" in refused.warnings[0].message
+    undeclared = config_xml.parse("u.xml", "<x>&e;</x>")  # no entity of any kind is read
+    assert not undeclared.parsed and "not valid XML" in undeclared.warnings[0].message
 
 
 def test_xml_too_deep_or_broken_is_not_measured() -> None:
