@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from archmetrics.app.collect import open_cache
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.estimate import EstimateRequest, run_estimate
 from archmetrics.app.history import HistoryRequest, run_history
 from archmetrics.app.scan import ScanRequest, run_scan

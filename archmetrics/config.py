@@ -6,6 +6,7 @@ over it. An unknown key or a value of the wrong type is an error naming the file
 
 from __future__ import annotations
 
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from archmetrics.globs import BadPattern, compile_glob
+from archmetrics.reading import TooLarge, read_regular
 
 CONFIG_FILES = ("archmetrics.toml", "pyproject.toml")
 
@@ -60,8 +62,13 @@ LIMIT_CEILINGS: dict[str, float] = {
     "nesting": 60_000,
     "parse-seconds": 3600,
 }
-"""The most a configuration may allow: an untrusted repository can make its own run slow,
-never endless."""
+"""The most a configuration may allow with ``--allow-raised-limits``: an untrusted
+repository can make its own run slow, never endless. Without the flag a repository may only
+lower a limit (app/settings.py)."""
+
+LIMIT_FLOORS: dict[str, float] = {"file-mb": 0.001}
+"""The least a limit may be where "more than 0" is not enough: ``file-mb = 1e-9`` would be
+a limit of 0 bytes."""
 
 _WHOLE_NUMBERS = {"worker-memory-mb", "nesting"}
 
@@ -74,8 +81,10 @@ def _limits(table: Mapping[str, Any], where: str) -> LimitSettings:
         number_types = (int,) if key in _WHOLE_NUMBERS else (int, float)
         if not isinstance(value, number_types) or isinstance(value, bool):
             raise ConfigError(f"{here}: expected a number")
-        if not 0 < value <= ceiling:  # NaN fails this too
-            raise ConfigError(f"{here}: expected more than 0 and at most {ceiling:g}")
+        floor = LIMIT_FLOORS.get(key)
+        if not 0 < value <= ceiling or (floor is not None and value < floor):  # NaN fails too
+            least = f"at least {floor:g}" if floor is not None else "more than 0"
+            raise ConfigError(f"{here}: expected {least} and at most {ceiling:g}")
         values[key.replace("-", "_")] = value
     return LimitSettings(**values)
 
@@ -129,7 +138,10 @@ class Settings:
     limits: LimitSettings = field(default_factory=LimitSettings)
     macros: MacroSettings = field(default_factory=MacroSettings)
     gate_lines: tuple[int, ...] = ()  # the line of ``source`` each of ``gates`` is written on
-    notices: tuple[str, ...] = ()  # what the reader should know of how this was read
+    notices: tuple[str, ...] = ()  # what the reader should know of how this was read, and
+    # what the run changed of these settings: said on stderr
+    revision: str | None = None  # the git revision they (and their rule packs) were read
+    # from; None: files on disk
 
 
 def _strings(value: Any, where: str) -> tuple[str, ...]:
@@ -244,8 +256,8 @@ def parse_settings(table: Mapping[str, Any], source: str) -> Settings:
         elif key == "macros":
             values["macros"] = _macros(_table(value, here), here)
         elif key == "cache-path":
-            if not isinstance(value, str):
-                raise ConfigError(f"{here}: expected a path")
+            if not isinstance(value, str) or "\0" in value:
+                raise ConfigError(f"{here}: expected a path (without a NUL character)")
             values["cache_path"] = value
         else:
             values["jobs"] = _int(value, here)
@@ -256,62 +268,87 @@ MAX_CONFIG_BYTES = 1 << 20
 """A configuration file larger than this (1 MiB) is refused rather than read."""
 
 
-def _read_toml(path: Path) -> dict[str, Any]:
-    """The TOML document at ``path``; ConfigError for anything that is not one, however odd
-    (a huge file, nesting deep enough to exhaust the parser's recursion, a bad encoding)."""
-    return _read_document(path)[0]
-
-
 def _read_document(path: Path) -> tuple[dict[str, Any], str]:
-    """The TOML document at ``path`` and its text (:func:`_read_toml`)."""
+    """The TOML document at ``path`` and its text; ConfigError for anything that is not
+    one, however odd (a huge file, a FIFO or device, nesting deep enough to exhaust the
+    parser's recursion, a bad encoding)."""
     try:
-        if path.stat().st_size > MAX_CONFIG_BYTES:
-            raise ConfigError(f"{path}: larger than {MAX_CONFIG_BYTES} bytes; not read")
-        text = path.read_text(encoding="utf-8")
-        return tomllib.loads(text), text
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ConfigError(f"{path}: not valid TOML: {error}") from error
-    except RecursionError:
-        raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
+        data = read_regular(path, MAX_CONFIG_BYTES)
+    except TooLarge:
+        raise ConfigError(f"{path}: larger than {MAX_CONFIG_BYTES} bytes; not read") from None
     except OSError as error:
         raise ConfigError(f"{path}: cannot read: {error.strerror or error}") from error
+    return parse_toml(data, str(path)), data.decode("utf-8", "replace")
+
+
+def parse_toml(data: bytes, source: str) -> dict[str, Any]:
+    """The TOML document in ``data`` (read from ``source``, which errors name)."""
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{source}: not valid TOML: {error}") from error
+    except RecursionError:
+        raise ConfigError(f"{source}: not valid TOML: nested too deeply") from None
+
+
+def _inside(root: Path, path: Path) -> bool:
+    """Whether ``path``, its symbolic links followed, lies in ``root`` (likewise)."""
+    real_root = os.path.realpath(root)
+    return os.path.commonpath([real_root, os.path.realpath(path)]) == real_root
 
 
 def load_settings(root: Path) -> Settings:
-    """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``.
+    """Settings from ``archmetrics.toml``, else ``pyproject.toml``'s table, in ``root``. A
+    configuration file that is a symbolic link leading out of ``root``, a FIFO or a device
+    is an error, never read.
 
     What the reader should know comes as ``notices``: both files configure archmetrics (the
     first is read, the other ignored), or pyproject.toml has a ``[tool.NAME]`` table whose
     name is close to ``archmetrics`` (a typo that would otherwise be silently ignored)."""
-    found: list[tuple[Path, Mapping[str, Any], str]] = []
+    found: list[tuple[Path, Settings]] = []
     notices: list[str] = []
     for name in CONFIG_FILES:
         path = root / name
-        if not path.is_file():
+        if not os.path.lexists(path):
             continue
+        if not _inside(root, path):
+            raise ConfigError(f"{path}: a symbolic link leading out of the repository; not read")
         document, text = _read_document(path)
         tool = document.get("tool", {})
-        if not isinstance(tool, dict):
-            raise ConfigError(f"{path}: tool: expected a table")
-        if name == "pyproject.toml":
+        if name == "pyproject.toml" and isinstance(tool, dict):
             notices += _near_misses(tool, path)
-            table = tool.get("archmetrics")
-            if table is None:
-                continue
-        else:
-            table = tool.get("archmetrics", document)
-        found.append((path, _table(table, f"{path}: tool.archmetrics"), text))
+        settings = settings_from_document(document, name, str(path), text)
+        if settings is not None:
+            found.append((path, settings))
     if not found:
         return Settings(notices=tuple(notices))
-    path, table, text = found[0]
+    path, settings = found[0]
     if len(found) > 1:
         notices.append(
             f"{path} and [tool.archmetrics] in {found[1][0]} both configure archmetrics: "
             f"{path.name} is read, pyproject.toml's table is ignored"
         )
-    settings = parse_settings(table, str(path))
+    return replace(settings, notices=tuple(notices))
+
+
+def settings_from_document(
+    document: Mapping[str, Any], name: str, source: str, text: str = ""
+) -> Settings | None:
+    """The settings in the TOML ``document`` of the configuration file ``name`` (read from
+    ``source``; ``text``, its text, gives each gate's line), or None for a
+    ``pyproject.toml`` without a ``[tool.archmetrics]`` table."""
+    tool = document.get("tool", {})
+    if not isinstance(tool, dict):
+        raise ConfigError(f"{source}: tool: expected a table")
+    if name == "pyproject.toml":
+        table = tool.get("archmetrics")
+        if table is None:
+            return None
+    else:
+        table = tool.get("archmetrics", document)
+    settings = parse_settings(_table(table, f"{source}: tool.archmetrics"), source)
     lines = tuple(_line_of(text, gate) for gate in settings.gates)
-    return replace(settings, gate_lines=lines, notices=tuple(notices))
+    return replace(settings, gate_lines=lines)
 
 
 def _near_misses(tool: Mapping[str, Any], path: Path) -> list[str]:

@@ -7,7 +7,7 @@ The oracle is benchmarks/ros_oracle/ (README.md there: code bases, commits, how 
 labelled). Each pinned code base must be checked out at its commit in ``DIR/<owner>__<name>``
 (default benchmarks/.work/ros). ``--clone`` makes missing ones with ``git clone`` and a
 checkout of the commit, limited to the labelled slice (sparse checkout); without network,
-bring the repository another way (``fetch github:<owner>/<name>`` in the session tools, then
+bring the repository another way (a mirror of ``github:<owner>/<name>``, then
 ``git clone --no-checkout <mirror> DIR/<owner>__<name>`` and ``git -C ... checkout <commit>``).
 For each one the script runs ``archmetrics scan --by link --format json`` on the slice, keeps
 the sites of rule packs named ``ros*`` in labelled files, matches them to the oracle's rows

@@ -64,3 +64,33 @@ def checksums(root: Path) -> dict[str, tuple[str, int]]:
                 digest = "dir"
             found[str(path.relative_to(root))] = (digest, info.st_mode)
     return found
+
+
+def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = None) -> Run:
+    """``archmetrics ARGV`` in this process (no interpreter to start: the security suite
+    runs hundreds of commands), in ``cwd`` with the environment ``env`` added; what it
+    printed is captured."""
+    import contextlib
+    import io
+
+    from archmetrics.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    saved = {key: os.environ.get(key) for key in env or {}}
+    previous = os.getcwd()
+    os.environ.update(env or {})
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main(list(argv))
+            except SystemExit as exit:  # argparse's own usage errors
+                code = exit.code if isinstance(exit.code, int) else 2
+    finally:
+        os.chdir(previous)
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+    return Run(code, out.getvalue(), err.getvalue())

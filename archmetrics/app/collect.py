@@ -13,7 +13,7 @@ from archmetrics.config import LimitSettings, MacroSettings, Settings
 from archmetrics.facts import FileFacts, ParseWarning, Severity
 from archmetrics.parsers import LanguageTable, ParseLimits
 from archmetrics.parsers.c_family_macros import MacroNames
-from archmetrics.parsers.limits import stack_bytes
+from archmetrics.parsers.limits import stack_bytes, too_large
 from archmetrics.sources import Snapshot, SourceFile, codec
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.snapshot import Sized, blob_hash
@@ -92,9 +92,14 @@ def parse_all(
     progress = progress or NoProgress()
     results: list[FileFacts | None] = [None] * len(selected)
     todo: list[_Todo] = []
+    max_bytes = limits.parser.max_bytes
     for index, item in enumerate(selected):
         blob, data = item.file.blob, None
-        if not blob:  # a file on disk: hash it the way git would
+        if not blob:  # a file on disk: hash it the way git would (over the limit: unread)
+            size = snapshot.size(item.file) if isinstance(snapshot, Sized) else None
+            if size is not None and size > max_bytes:
+                results[index] = too_large(item.file.path, item.language, size, limits.parser)
+                continue
             data = snapshot.read(item.file)
             blob = blob_hash(data)
         if blobs is not None:
@@ -127,7 +132,7 @@ def parse_all(
             facts = codec.decode(answer.encoded, path)
         results[entry.index] = facts
 
-    todo = largest_first(todo, snapshot)
+    todo = largest_first(todo, snapshot, results, limits)
     workers = worker_count(jobs)
     size = batch_size(len(todo), workers)
     batches = [todo[i : i + size] for i in range(0, len(todo), size)]
@@ -145,12 +150,16 @@ def parse_all(
     return tuple(f for f in results if f is not None)
 
 
-def largest_first(todo: list[_Todo], snapshot: Snapshot) -> list[_Todo]:
-    """The files to parse, largest first where their sizes are known (read, or on disk), so
-    that the last batches hold the smallest: a worker that takes a batch of large files
-    near the end keeps the run going while the others wait (numpy's f2c LAPACK files, 1 MB
-    and 0.4 s each, came last in path order: 0.5 s of one worker alone). Files of unknown
-    size (a revision's blobs) keep their order, after the others."""
+def largest_first(
+    todo: list[_Todo], snapshot: Snapshot, results: list[FileFacts | None], limits: WorkerLimits
+) -> list[_Todo]:
+    """The files to parse, largest first where their sizes are known (read, on disk, or a
+    blob's as git's object header gives it), so that the last batches hold the smallest: a
+    worker that takes a batch of large files near the end keeps the run going while the
+    others wait (numpy's f2c LAPACK files, 1 MB and 0.4 s each, came last in path order:
+    0.5 s of one worker alone). Files of unknown size keep their order, after the others.
+    A file over the size limit is not parsed, nor read: it goes to ``results`` as not
+    measured, naming the limit."""
     sized = snapshot if isinstance(snapshot, Sized) else None
 
     def size(entry: _Todo) -> int:
@@ -160,7 +169,16 @@ def largest_first(todo: list[_Todo], snapshot: Snapshot) -> list[_Todo]:
         return -1 if known is None else known
 
     sizes = [size(entry) for entry in todo]
-    order = sorted(range(len(todo)), key=lambda index: -sizes[index])  # stable: ties keep order
+    kept = []
+    for index, entry in enumerate(todo):
+        if sizes[index] > limits.parser.max_bytes:
+            item = entry.item
+            results[entry.index] = too_large(
+                item.file.path, item.language, sizes[index], limits.parser
+            )
+        else:
+            kept.append(index)
+    order = sorted(kept, key=lambda index: -sizes[index])  # stable: ties keep their order
     return [todo[index] for index in order]
 
 

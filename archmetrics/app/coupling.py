@@ -11,9 +11,12 @@ from typing import TYPE_CHECKING
 
 from archmetrics.config import Settings
 from archmetrics.coupling import CouplingOptions, CouplingReport, load_rule_packs, measure_coupling
+from archmetrics.coupling.loader import MAX_PACK_BYTES, PackBytes, PackSource
 from archmetrics.coupling.rules import RulePackError, RuleSet
 from archmetrics.facts import FileFacts
 from archmetrics.globs import BadPattern, compile_glob, normalize_path
+from archmetrics.sources.checkout import Checkout, open_checkout
+from archmetrics.sources.revision_files import repository_path
 
 if TYPE_CHECKING:
     from pathspec import GitIgnoreSpec
@@ -30,12 +33,35 @@ def coupling_options(settings: Settings) -> CouplingOptions:
     )
 
 
-def rule_set(settings: Settings, root: Path) -> RuleSet:
-    """The built-in packs, the configured ones (paths relative to the root) and plugins; a
-    configuration rule's bad ``files`` glob fails here, naming the pack, rule and key."""
-    packs = load_rule_packs([pack_path(root, p) for p in settings.coupling.rule_packs])
+def rule_set(settings: Settings, root: Path, checkout: Checkout | None = None) -> RuleSet:
+    """The built-in packs, the configured ones (paths relative to the root: files on disk,
+    or the blobs of the revision the settings were read from) and plugins; a configuration
+    rule's bad ``files`` glob fails here, naming the pack, rule and key. ``checkout``: the
+    repository at ``root``, if the caller opened it already."""
+    configured = settings.coupling.rule_packs
+    sources: list[PackSource]
+    if settings.revision is None:
+        sources = [pack_path(root, p) for p in configured]
+    else:
+        checkout = checkout or open_checkout(root)
+        sources = [pack_at(checkout, settings.revision, p) for p in configured]
+    packs = load_rule_packs(sources)
     configuration_files(packs)
     return packs
+
+
+def pack_at(checkout: Checkout, revision: str, text: str) -> PackBytes:
+    """A configured rule pack as the blob at ``revision`` holds it (inside the repository,
+    a regular file: never a symbolic link)."""
+    path = repository_path(text)
+    if path is None:
+        raise RulePackError(
+            text, None, None, "a configured rule pack must be inside the repository"
+        )
+    data = checkout.file_at(revision, path, MAX_PACK_BYTES)
+    if data is None:
+        raise RulePackError(f"{revision}:{path}", None, None, "no such file at that revision")
+    return PackBytes(f"{revision}:{path}", data)
 
 
 _DIGESTS: dict[int, tuple[RuleSet, str]] = {}

@@ -12,15 +12,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from archmetrics.app.diff import (
-    DiffOptions,
-    DiffRequest,
-    diff_options,
-    measure_change,
-    parse_side,
-    parse_warnings,
-    site_memo,
-)
+from archmetrics.app.diff import measure_change, parse_side, parse_warnings
+from archmetrics.app.diff_cache import site_memo
+from archmetrics.app.diff_options import DiffOptions, DiffRequest, diff_options
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.settings import gate_origins
 from archmetrics.app.sketch import MeasuredBase, sketched
@@ -33,6 +27,7 @@ from archmetrics.changeset.plan import Architecture, Plan, PlanError
 from archmetrics.changeset.plan_read import MAX_PLAN_BYTES, read_plan
 from archmetrics.coupling import group_elements, measure_coupling
 from archmetrics.facts import ParseWarning
+from archmetrics.reading import TooLarge, read_regular
 from archmetrics.reports.model import (
     ArchitectureEstimate,
     DiffReport,
@@ -61,11 +56,13 @@ class EstimateRequest:
 
 
 def read_plan_file(path: Path) -> Plan:
-    """The plan in the file at ``path`` (read at most one byte past the size limit)."""
+    """The plan in the regular file at ``path`` (a FIFO or a link to ``/dev/stdin`` is
+    refused, never waited on; read at most one byte past the size limit)."""
     source = str(path)
     try:
-        with path.open("rb") as stream:
-            data = stream.read(MAX_PLAN_BYTES + 1)
+        data = read_regular(path, MAX_PLAN_BYTES)
+    except TooLarge:
+        raise PlanError(source, "", f"a plan may hold at most {MAX_PLAN_BYTES} bytes") from None
     except OSError as error:
         raise PlanError(source, "", f"cannot read: {error.strerror or error}") from None
     return read_plan(data, source)
@@ -192,8 +189,8 @@ def run_estimate(
     ``actual``, measure base..actual too and the error of every estimated figure.
     ``checkout``: the repository, if the caller opened it already."""
     checkout = checkout or open_checkout(request.diff.root)
-    options = diff_options(request.diff, checkout.root)  # a bad gate or plan fails before
-    gates = options.gates  # any work
+    options = diff_options(request.diff, checkout.root, checkout)  # a bad gate or plan
+    gates = options.gates  # fails before any work
     plan = _selected(read_plan_file(request.plan), request)
     progress = progress or NoProgress()
     bases: dict[str, MeasuredBase] = {}

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from archmetrics.app.collect import limits_salt, parse_all
 from archmetrics.app.coupling import packs_digest
-from archmetrics.app.diff import DiffOptions, DiffRequest, diff_options
+from archmetrics.app.diff_options import DiffOptions, DiffRequest, diff_options
 from archmetrics.app.history_walk import FileVersions, Walk, kept_step
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.tree import STATE_RECORD, Side, side_of, whole_side

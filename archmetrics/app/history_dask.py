@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from archmetrics.app.collect import Selected, not_measured
-from archmetrics.app.diff import DiffOptions
+from archmetrics.app.diff_options import DiffOptions
 from archmetrics.app.history_walk import (
     FileVersions,
     ListedSnapshot,

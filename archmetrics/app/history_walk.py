@@ -15,7 +15,8 @@ from typing import Protocol
 
 from archmetrics.app.collect import Selected
 from archmetrics.app.coupling import configuration_files
-from archmetrics.app.diff import DiffOptions, compare_sides
+from archmetrics.app.diff import compare_sides
+from archmetrics.app.diff_options import DiffOptions
 from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.app.tree import Side, patched_side, state_key, whole_side
 from archmetrics.changeset.history import CommitStep, commit_step, step_from_record, step_record

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.progress import Progress
 from archmetrics.app.series import SeriesRequest, run_compare
 from archmetrics.config import LocationSettings, Settings

@@ -10,7 +10,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest, diff_options, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest, diff_options
 from archmetrics.app.progress import Progress
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources import EMPTY
@@ -56,7 +57,7 @@ def run_series(
     pairs = stage_pairs(request)
     checkout = checkout or open_checkout(request.diff.root)  # once for all stages, as are
     # the options
-    options = diff_options(request.diff, checkout.root)
+    options = diff_options(request.diff, checkout.root, checkout)
     stages = []
     for label, base, head in pairs:
         stage = replace(request.diff, base=base, head=head)

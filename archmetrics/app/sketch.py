@@ -6,7 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from archmetrics.app.diff import DiffOptions, DiffRequest, measure_snapshots
+from archmetrics.app.diff import measure_snapshots
+from archmetrics.app.diff_options import DiffOptions, DiffRequest
 from archmetrics.app.progress import Progress
 from archmetrics.changeset import ChangeReport
 from archmetrics.changeset.estimate import BaseState

@@ -39,7 +39,7 @@ from archmetrics.sources.codec import CodecError
 from archmetrics.sources.gitdelta import Delta, Pending
 
 if TYPE_CHECKING:
-    from archmetrics.app.diff import DiffOptions
+    from archmetrics.app.diff_options import DiffOptions
 
 STATE_RECORD = "tree-state/1"
 _CONFIGURATION = frozenset({"xml", "yaml"})  # a tree holding these is ROS: patched whole
@@ -194,7 +194,7 @@ def _couple(
     options: DiffOptions,
     cache: FactsCache | None,
 ) -> CouplingIndex:
-    from archmetrics.app.diff import site_memo
+    from archmetrics.app.diff_cache import site_memo
 
     measured = measured_files(facts, options.rules)
     blobs = {row.path: row.blob for row in rows}
@@ -313,7 +313,7 @@ def _patched_index(
     lazy = LazyFacts(frozenset(index.paths), side.facts)
     memo = None
     if cache is not None:
-        from archmetrics.app.diff import site_memo
+        from archmetrics.app.diff_cache import site_memo
 
         memo = site_memo(cache, side.by_path, {}, options.coupling, options.packs)
     return patch_index(index, redone, lazy, options.coupling, options.packs, memo)

@@ -9,29 +9,16 @@ them apart: ``function`` and ``file`` are units, everything else a location.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from archmetrics.changeset.gates import Gate, is_unit_gate, parse_gate
 from archmetrics.changeset.locations import Location, LocationRules
 from archmetrics.changeset.model import ChangeReport
 from archmetrics.changeset.touched import touched
-from archmetrics.complexity.thresholds import FIELDS, Threshold, Unit, parse_threshold
+from archmetrics.complexity.thresholds import FIELDS, Unit
 
 if TYPE_CHECKING:
     from archmetrics.app.tree import Side
-
-
-def split_gates(texts: Iterable[str]) -> tuple[tuple[Gate, ...], tuple[Threshold, ...]]:
-    """Location gates and unit gates, each parsed (a bad one fails here, before any work)."""
-    gates, thresholds = [], []
-    for text in texts:
-        if is_unit_gate(text):
-            thresholds.append(parse_threshold(text))
-        else:
-            gates.append(parse_gate(text))
-    return tuple(gates), tuple(thresholds)
 
 
 def touched_units(change: ChangeReport) -> dict[str, list[Unit]]:

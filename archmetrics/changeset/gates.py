@@ -15,7 +15,13 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from archmetrics.changeset.model import SUMMARY_FIELDS, Summary
-from archmetrics.complexity.thresholds import COMPARISON, OPERATORS, or_of_ands
+from archmetrics.complexity.thresholds import (
+    COMPARISON,
+    OPERATORS,
+    Threshold,
+    or_of_ands,
+    parse_threshold,
+)
 
 _CONDITION = re.compile(
     r"^\s*(?P<field>[a-z_]+)\s*(?:\(\s*(?P<location>[a-z]+)\s*\))?\s*" + COMPARISON
@@ -132,3 +138,45 @@ def check_gates(gates: Iterable[Gate], summaries: Mapping[str, Summary]) -> tupl
             values = tuple((c.name, c.value(summaries) or 0.0) for c in group)
             failures.append(GateFailure(gate, values))
     return tuple(failures)
+
+
+UNMEASURED_GATE = "unmeasured(head) > 0"
+"""The gate every gated diff adds: no file the base's configuration measures may go
+unmeasured in the head (docs/ci.md, "Whose configuration")."""
+
+_SHOWN_UNMEASURED = 5
+
+
+@dataclass(frozen=True, slots=True)
+class UnmeasuredFailure(GateFailure):
+    """The head leaves ``files`` unmeasured that the base's configuration measures: (path,
+    why) each, e.g. excluded by the head's configuration, not parsed, newly generated."""
+
+    files: tuple[tuple[str, str], ...] = ()
+
+    def __str__(self) -> str:
+        shown = "; ".join(f"{path} ({why})" for path, why in self.files[:_SHOWN_UNMEASURED])
+        more = len(self.files) - _SHOWN_UNMEASURED
+        shown += f"; and {more} more" if more > 0 else ""
+        count = f"{len(self.files)} file" + ("s" if len(self.files) != 1 else "")
+        return (
+            f"gate failed: {self.gate.text} ({count} the base's configuration measures not"
+            f" measured in the head: {shown})"
+        )
+
+
+def unmeasured_failure(files: Iterable[tuple[str, str]]) -> UnmeasuredFailure:
+    """The failure of :data:`UNMEASURED_GATE` for these (path, why) pairs."""
+    found = tuple(files)
+    return UnmeasuredFailure(Gate(UNMEASURED_GATE, ()), (("unmeasured(head)", len(found)),), found)
+
+
+def split_gates(texts: Iterable[str]) -> tuple[tuple[Gate, ...], tuple[Threshold, ...]]:
+    """Location gates and unit gates, each parsed (a bad one fails here, before any work)."""
+    gates, thresholds = [], []
+    for text in texts:
+        if is_unit_gate(text):
+            thresholds.append(parse_threshold(text))
+        else:
+            gates.append(parse_gate(text))
+    return tuple(gates), tuple(thresholds)

@@ -169,7 +169,7 @@ def diff_files(pre: FileFacts | None, post: FileFacts | None) -> FileChange:
 
 
 # A file pair's change as a record of JSON types, kept in the cache by the two files' blobs
-# (app/diff.py) so that a diff seen before reads neither file's statements again:
+# (app/diff_cache.py) so that a diff seen before reads neither file's statements again:
 # [added, removed, modified, approximate, [[action, pre, post, moved], ...]], a statement
 # [kind, start, end, text, function].
 CHANGE_RECORD = "file-change/1"

@@ -19,8 +19,9 @@ from archmetrics.app.series import SeriesError
 from archmetrics.changeset.gates import GateError
 from archmetrics.changeset.plan import PlanError
 from archmetrics.cli import baseline, docs, estimate, history, measure, study
-from archmetrics.cli.common import EXIT_USAGE, UsageError
-from archmetrics.cli.parser import build_parser, settle_format
+from archmetrics.cli.common import EXIT_USAGE, UsageError, check_paths
+from archmetrics.cli.options import settle_format
+from archmetrics.cli.parser import build_parser
 from archmetrics.complexity.thresholds import ThresholdError
 from archmetrics.config import ConfigError
 from archmetrics.coupling.rules import RulePackError
@@ -93,6 +94,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise UsageError("--jobs must be 0 or more")
         if (getattr(args, "max_rows", None) or 0) < 0:
             raise UsageError("--max-rows must be 0 or more")
+        check_paths(args)
         with few_collections():
             return COMMANDS[args.command](args)
     except CANNOT_MEASURE as error:

@@ -23,6 +23,8 @@ from archmetrics.reports.model import EstimateFailure
 from archmetrics.reports.printable import one_line, shown_lines
 from archmetrics.reports.table_report import SHOWN_FAILURES
 from archmetrics.sources.cache import FactsCache, choose_path
+from archmetrics.sources.checkout import Checkout
+from archmetrics.sources.confine import confined, write_confined
 
 EXIT_OK, EXIT_GATE, EXIT_USAGE = 0, 1, 2
 
@@ -93,16 +95,21 @@ class RichProgress:
         self._status: Any = None  # a rich Status: the spinner of a step without a count
 
     def phase(self, description: str) -> None:
-        """A spinner and the step's name, until the next step."""
+        """A spinner and the step's name, until the next step (a name may hold a tag of
+        the repository's: never read as rich markup)."""
         self.stop()
-        self._status = self._console.status(f"{description} ...")
+        from rich.markup import escape
+
+        self._status = self._console.status(f"{escape(description)} ...")
         self._status.start()
 
     def start(self, description: str, total: int) -> None:
         self.stop()
         if total >= 20:
             self._bar.start()
-            self._task = self._bar.add_task(description, total=total)
+            from rich.markup import escape
+
+            self._task = self._bar.add_task(escape(description), total=total)
 
     def advance(self, count: int = 1) -> None:
         if self._task is not None:
@@ -149,11 +156,32 @@ def settings_at(root: Path, args: argparse.Namespace | None = None) -> Settings:
     return _with_excludes(app_settings.settings_at, root, args)
 
 
+def settings_of(checkout: Checkout, spec: str | None, args: argparse.Namespace) -> Settings:
+    """As :func:`settings_for`, of the snapshot ``spec`` names (a revision's own
+    configuration, read from its blobs: app.settings.settings_of)."""
+
+    def load(_: Path, exclude: tuple[str, ...], raised: bool) -> Settings:
+        return app_settings.settings_of(checkout, spec, exclude, raised)
+
+    return _with_excludes(load, checkout.root, args)
+
+
+def settings_from_file(path: Path, args: argparse.Namespace) -> Settings:
+    """As :func:`settings_for`, of the runner's file ``path`` (``--config-from FILE``)."""
+    return _with_excludes(app_settings.settings_from_file, path, args)
+
+
 def _with_excludes(
-    load: Callable[[Path, tuple[str, ...]], Settings], path: Path, args: argparse.Namespace | None
+    load: Callable[[Path, tuple[str, ...], bool], Settings],
+    path: Path,
+    args: argparse.Namespace | None,
 ) -> Settings:
+    """The settings ``load`` reads, with the command line's --exclude globs and, with
+    --allow-raised-limits, the configuration's limits above the defaults; each limit put
+    back to its default is a warning."""
     try:
-        settings = load(path, tuple(getattr(args, "exclude", None) or ()))
+        raised = bool(getattr(args, "allow_raised_limits", False))
+        settings = load(path, tuple(getattr(args, "exclude", None) or ()), raised)
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
     group = getattr(args, "group", None)
@@ -165,6 +193,26 @@ def _with_excludes(
     if args is not None:
         _detail(args, f"configuration: {settings.source}")
     return settings
+
+
+_READ_PATHS = ("paths", "repo", "plan")  # the arguments naming what a command reads
+
+
+def check_paths(args: argparse.Namespace) -> None:
+    """Every path the command line names for reading (``scan PATH``, ``-C``, ``NAME=PATH``,
+    the plan, ``--config-from FILE``), checked before any work: a symbolic link on the way
+    that leads out of the repository holding it is a one-line error (sources/confine.py).
+    The paths themselves are used as given."""
+    named: list[Path] = []
+    for attribute in _READ_PATHS:
+        value = getattr(args, attribute, None)
+        values = value if isinstance(value, list) else [value] if value is not None else []
+        named += [Path(v) for v in values]
+    named += [Path(text.partition("=")[2]) for text in getattr(args, "repos", None) or []]
+    if getattr(args, "config_from", "base") not in ("base", "head"):
+        named.append(Path(args.config_from))
+    for path in named:
+        confined(path)
 
 
 def emit(text: str, output: Path | None) -> None:
@@ -179,10 +227,16 @@ def emit(text: str, output: Path | None) -> None:
             sys.stdout.buffer.write(text.encode("utf-8", "backslashreplace"))
             sys.stdout.buffer.flush()
         return
+    write_output(output, text.encode("utf-8", "backslashreplace"))
+
+
+def write_output(output: Path, data: bytes) -> None:
+    """``data`` into the file ``output`` (created or replaced; never through a symbolic link
+    inside a repository, nor through one on the way leading out of it: sources/confine.py)."""
     try:
-        output.write_text(text, encoding="utf-8", errors="backslashreplace")
+        write_confined(output, data)
     except OSError as error:
-        raise UsageError(f"{output}: cannot write: {error.strerror}") from error
+        raise UsageError(f"{output}: cannot write: {error.strerror or error}") from error
 
 
 def warn(message: str) -> None:

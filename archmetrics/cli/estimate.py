@@ -24,7 +24,7 @@ def estimate_command(args: argparse.Namespace) -> int:
     checkout = open_checkout(args.repo)
     request = EstimateRequest(
         Path(args.plan),
-        diff_request(args, checkout, args.base, ""),
+        diff_request(args, checkout, args.base, "", config_head=args.head if args.actual else None),
         args.head if args.actual else None,
         args.stage,
         tuple(args.architecture),

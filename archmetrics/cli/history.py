@@ -18,6 +18,7 @@ from archmetrics.reports.history_report import HistoryFormat, View, render_histo
 from archmetrics.sources.cache import FactsCache
 from archmetrics.sources.checkout import open_checkout
 from archmetrics.sources.githistory import Range
+from archmetrics.sources.snapshot import WORKTREE
 
 
 @contextmanager
@@ -51,12 +52,18 @@ def history_command(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise UsageError("--workers needs a number of at least 1")
     request = HistoryRequest(
-        diff_request(args, checkout), history_range(args), args.scheduler, args.workers
+        # the configuration on disk: the range's commits each have their own, and one
+        # run measures every commit by one set of rules
+        diff_request(args, checkout, config_base=WORKTREE, config_head=WORKTREE),
+        history_range(args),
+        args.scheduler,
+        args.workers,
     )
     shown = OutputFormat.TABLE if fmt is HistoryFormat.TABLE else OutputFormat.JSON
-    with _history_cache(args, request.diff.settings) as cache, shown_progress(
-        shown, args.quiet
-    ) as progress:
+    with (
+        _history_cache(args, request.diff.settings) as cache,
+        shown_progress(shown, args.quiet) as progress,
+    ):
         report = run_history(request, progress, cache, checkout)
         progress.phase("writing the report")
         text = render_history(report, fmt, View(args.top, args.element))

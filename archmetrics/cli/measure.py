@@ -7,7 +7,8 @@ import os
 import sys
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.progress import NoProgress
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.app.series import SeriesRequest, parse_named_path, run_compare, run_series
@@ -20,12 +21,15 @@ from archmetrics.cli.common import (
     facts_cache,
     gate_status,
     sample_path,
-    settings_at,
     settings_for,
+    settings_from_file,
+    settings_of,
     shown_progress,
     split,
     warn,
+    write_output,
 )
+from archmetrics.config import Settings
 from archmetrics.reports.charts import charts_missing
 from archmetrics.reports.diff_rows import unmatched_glob
 from archmetrics.reports.formats import (
@@ -39,7 +43,7 @@ from archmetrics.reports.formats import (
 from archmetrics.reports.model import CompareReport, SeriesReport, Stage
 from archmetrics.sources.checkout import Checkout, open_checkout
 from archmetrics.sources.paths import quote_path
-from archmetrics.sources.snapshot import resolve_path
+from archmetrics.sources.snapshot import EMPTY, WORKTREE, resolve_path
 
 
 def check_chart(args: argparse.Namespace) -> str | None:
@@ -67,11 +71,7 @@ def write_chart(args: argparse.Namespace, report: CompareReport) -> None:
         return
     from archmetrics.reports.charts import render_compare_chart
 
-    data = render_compare_chart(report, args.chart_kind, fmt)
-    try:
-        args.chart.write_bytes(data)
-    except OSError as error:
-        raise UsageError(f"{args.chart}: cannot write: {error.strerror}") from error
+    write_output(args.chart, render_compare_chart(report, args.chart_kind, fmt))
 
 
 def cache_command(args: argparse.Namespace) -> int:
@@ -219,17 +219,44 @@ def check_hook_files(files: list[str], checkout: Checkout) -> None:
         )
 
 
+def configuration(
+    args: argparse.Namespace, checkout: Checkout, base: str, head: str
+) -> tuple[Settings, Settings | None]:
+    """The settings a comparison runs under, as ``--config-from`` says: the ``base``
+    revision's (the default), the ``head``'s or the runner's file; and, when they are not
+    the base's, the base's too (the implicit gate unmeasured(head) judges by them)."""
+    choice = getattr(args, "config_from", "base")
+    if choice == "base":
+        return settings_of(checkout, base, args), None
+    chosen = settings_of(checkout, head, args) if choice == "head" else (
+        settings_from_file(Path(choice), args)
+    )  # fmt: skip
+    return chosen, settings_of(checkout, base, args)
+
+
 def diff_request(
-    args: argparse.Namespace, checkout: Checkout, base: str = "", head: str = "", label: str = ""
+    args: argparse.Namespace,
+    checkout: Checkout,
+    base: str = "",
+    head: str = "",
+    label: str = "",
+    config_base: str | None = None,
+    config_head: str | None = None,
 ) -> DiffRequest:
     """The command line's diff, in the repository the command opened: flags and settings
-    are merged from here on once (``app.diff.diff_options``)."""
+    are merged from here on once (``app.diff_options.diff_options``). The configuration is that of
+    ``config_base`` and ``config_head`` (default: ``base``, ``head``) as ``--config-from``
+    chooses."""
+    settings, base_settings = configuration(
+        args, checkout, config_base or base, config_head or head or WORKTREE
+    )
     return DiffRequest(
         root=checkout.root,
         base=base,
         head=head,
         base_label=label,
-        settings=settings_at(checkout.root, args),
+        settings=settings,
+        base_settings=base_settings,
         new=tuple(args.new),
         framework=tuple(args.framework),
         gates=tuple(args.fail_on),
@@ -243,8 +270,12 @@ def series_command(args: argparse.Namespace) -> int:
     check_chart(args)
     fmt = OutputFormat(args.format)
     checkout = open_checkout(args.repo)
+    revisions = tuple(args.revisions)
     request = SeriesRequest(
-        diff_request(args, checkout), tuple(args.revisions), split(args.labels), args.root
+        diff_request(args, checkout, **_series_configuration(args.root, revisions)),
+        revisions,
+        split(args.labels),
+        args.root,
     )
     with facts_cache(args, request.diff.settings) as cache, shown_progress(fmt, args.quiet) as p:
         report = run_series(request, p, cache, checkout)
@@ -265,7 +296,10 @@ def compare_command(args: argparse.Namespace) -> int:
         checkout = open_checkout(path)
         revisions = split(args.revisions) or checkout.tags()
         request = SeriesRequest(
-            diff_request(args, checkout), revisions, split(args.labels), args.root
+            diff_request(args, checkout, **_series_configuration(args.root, revisions)),
+            revisions,
+            split(args.labels),
+            args.root,
         )
         named.append((name, request))
         checkouts[name] = checkout
@@ -277,6 +311,13 @@ def compare_command(args: argparse.Namespace) -> int:
     emit(text, args.output)
     write_chart(args, report)
     return gate_status(report.failures, args)
+
+
+def _series_configuration(root: str, revisions: tuple[str, ...]) -> dict[str, str]:
+    """Where a series takes its configuration from: its first stage's base (``--root``,
+    or the first revision when that is EMPTY), or its last revision."""
+    first = revisions[0] if root == EMPTY and revisions else root
+    return {"config_base": first, "config_head": revisions[-1] if revisions else WORKTREE}
 
 
 def diff_command(args: argparse.Namespace) -> int:

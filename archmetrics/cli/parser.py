@@ -3,180 +3,25 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
 from pathlib import Path
 
 from archmetrics import __version__
-from archmetrics.cli.common import Parser, UsageError
+from archmetrics.cli.common import Parser
 from archmetrics.cli.docs import docs_root
-from archmetrics.reports.charts import chart_kinds
+from archmetrics.cli.options import (
+    add_allow_raised_limits,
+    add_baseline,
+    add_chart,
+    add_config_from,
+    add_exclude,
+    add_format,
+    add_group,
+    add_history,
+    add_locations,
+    add_max_rows,
+    add_output,
+)
 from archmetrics.reports.formats import Grouping, OutputFormat
-
-# What a suffix of --output means when --format is not given (an explicit --format wins).
-SUFFIX_FORMATS = {
-    ".json": "json",
-    ".sarif": "sarif",
-    ".md": "markdown",
-    ".markdown": "markdown",
-    ".csv": "csv",
-    ".txt": "table",
-    ".dot": "dot",
-    ".gv": "dot",
-    ".mmd": "mermaid",
-}
-
-
-def add_output(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
-    _add_format(parser, formats)
-    parser.add_argument(
-        "--output",
-        "-o",
-        type=Path,
-        help="write the report to FILE (.json, .md, .csv or .sarif picks the format unless"
-        " --format)",
-    )
-    parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
-    parser.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
-    parser.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
-    parser.add_argument("--cache-path", type=Path, help="the facts cache file to use")
-    add_exclude(parser)
-
-
-def add_group(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--group",
-        choices=["component", "file", "package", "node"],
-        default=None,
-        help="what one element is: a C/C++ header and its source (component, the default), a"
-        " file, a ROS package (the folder holding package.xml) or a ROS node's files",
-    )
-
-
-def add_exclude(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--exclude",
-        action="append",
-        default=[],
-        metavar="GLOB",
-        help="leave out the files this glob matches, after the configured `exclude` (repeatable;"
-        " each one excluded is listed in the report)",
-    )
-
-
-def _add_format(parser: argparse.ArgumentParser, formats: Sequence[str]) -> None:
-    default = formats[0]
-    parser.add_argument(
-        "--format", choices=formats, default=None, help=f"output format (default: {default})"
-    )
-    parser.set_defaults(format_choices=tuple(formats), format_default=default)
-
-
-def settle_format(args: argparse.Namespace) -> None:
-    """``args.format`` when --format was not given: what the suffix of --output names, or
-    the command's default for a file with no suffix (or no file). A suffix that names none
-    of the command's formats (``report.html``) is a usage error, never a table written
-    under a name that says otherwise."""
-    if getattr(args, "format", "") is not None or not hasattr(args, "format_default"):
-        return
-    output = getattr(args, "output", None)
-    suffix = output.suffix.lower() if output is not None else ""
-    named = SUFFIX_FORMATS.get(suffix)
-    if suffix and named not in args.format_choices:
-        known = ", ".join(s for s, f in SUFFIX_FORMATS.items() if f in args.format_choices)
-        raise UsageError(
-            f"{output}: {suffix} names no format of this command (endings: {known});"
-            f" give --format ({', '.join(args.format_choices)})"
-        )
-    args.format = named or args.format_default
-
-
-def add_chart(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--chart", type=Path, metavar="FILE", help="also draw a chart into FILE (.png or .svg)"
-    )
-    parser.add_argument(
-        "--chart-kind", default="cost", choices=chart_kinds(), help="which chart (default: cost)"
-    )
-
-
-def add_baseline(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--baseline",
-        type=Path,
-        metavar="FILE",
-        help="offenders already known (archmetrics baseline): thresholds and function gates"
-        " fail only on new offenders and on offenders that got worse",
-    )
-
-
-def add_max_rows(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--max-rows",
-        type=int,
-        metavar="N",
-        help="Markdown: at most N changed elements, the most changed first (0: all; default: "
-        "as many as fit in a pull-request comment, 65,536 characters)",
-    )
-
-
-def add_locations(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--new", action="append", default=[], metavar="GLOB", help="new location")
-    parser.add_argument(
-        "--framework", action="append", default=[], metavar="GLOB", help="framework location"
-    )
-    parser.add_argument(
-        "--fail-on",
-        action="append",
-        default=[],
-        metavar="EXPR",
-        help="a gate, e.g. 'cost(new) > 20'; exit 1 when it fails (repeatable)",
-    )
-    parser.add_argument(
-        "--dynamic-pre-zero",
-        action="store_true",
-        help="take d_a, d_e before integration as 0 (the thesis's convention, p. 100)",
-    )
-
-
-def add_history(commands: argparse._SubParsersAction[Parser]) -> None:
-    history = commands.add_parser(
-        "history",
-        help="every commit of a branch against its first parent: Γ, ΔVg', E per location,"
-        " the costliest commits and the elements where integration cost accumulates",
-    )
-    history.add_argument(
-        "range", nargs="?", default="HEAD", metavar="REV_RANGE",
-        help="the commits, as git log takes them (default HEAD: its whole history)",
-    )  # fmt: skip
-    history.add_argument(
-        "--first-parent", action=argparse.BooleanOptionalAction, default=True,
-        help="follow only first parents, each merge one integrated branch (default: on)",
-    )  # fmt: skip
-    history.add_argument(
-        "--merges", action="store_true", help="only merge commits, each against its first parent"
-    )
-    history.add_argument("--since", metavar="DATE", help="commits after DATE (as git reads it)")
-    history.add_argument("--until", metavar="DATE", help="commits before DATE")
-    history.add_argument(
-        "--max-count", "-n", type=int, metavar="N", help="only the newest N commits"
-    )
-    history.add_argument("--repo", "-C", type=Path, default=Path("."), help="the repository")
-    history.add_argument(
-        "--top", type=int, default=10, metavar="N",
-        help="how many costliest commits and hotspot elements to show (default 10)",
-    )  # fmt: skip
-    history.add_argument("--element", metavar="NAME", help="also show this element's own trend")
-    history.add_argument(
-        "--scheduler", metavar="ADDRESS",
-        help="run on the Dask cluster whose scheduler is at ADDRESS, e.g. tcp://host:8786"
-        " (needs archmetrics[dask]; docs/history.md)",
-    )  # fmt: skip
-    history.add_argument(
-        "--workers", type=int, metavar="N", help="run on a local Dask cluster of N workers"
-    )
-    add_locations(history)
-    add_chart(history)
-    add_output(history, ["table", "json", "markdown", "csv"])
 
 
 def docs_epilog() -> str:
@@ -226,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_output(scan, [f.value for f in OutputFormat])
     add_baseline(scan)
+    add_allow_raised_limits(scan)
     add_group(scan)
     baseline = commands.add_parser(
         "baseline",
@@ -248,6 +94,7 @@ def build_parser() -> argparse.ArgumentParser:
     baseline.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     baseline.add_argument("--cache-path", type=Path, help="the facts cache file to use")
     add_exclude(baseline)
+    add_allow_raised_limits(baseline)
     diff = commands.add_parser(
         "diff", help="the chapter-6 metrics of a change: Γ, scale factors, ΔVg, cost E per location"
     )
@@ -280,6 +127,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_max_rows(diff)
     add_group(diff)
     add_baseline(diff)
+    add_allow_raised_limits(diff)
+    add_config_from(diff, "--base's", "--head's")
     series = commands.add_parser(
         "series", help="each stage measured against the one before (baseline, first, second)"
     )
@@ -291,6 +140,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(series)
     add_output(series, [f.value for f in OutputFormat])
     add_max_rows(series)
+    add_allow_raised_limits(series)
+    add_config_from(series, "the first stage's base (--root, or the first REV)", "the last REV's")
     compare = commands.add_parser(
         "compare", help="the same series for several repositories side by side"
     )
@@ -304,6 +155,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(compare)
     add_chart(compare)
     add_output(compare, [f.value for f in OutputFormat])
+    add_allow_raised_limits(compare)
+    add_config_from(compare, "each repository's first stage's base", "its last revision's")
     add_history(commands)
     estimate = commands.add_parser(
         "estimate",
@@ -335,6 +188,8 @@ def build_parser() -> argparse.ArgumentParser:
     add_locations(estimate)
     add_chart(estimate)
     add_output(estimate, [f.value for f in OutputFormat])
+    add_allow_raised_limits(estimate)
+    add_config_from(estimate, "--base's", "--head's (with --actual; else the work tree's)")
     replicate = commands.add_parser(
         "replicate", help="the thesis's study on the bundled subjects: report, findings, charts"
     )
@@ -360,7 +215,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph = commands.add_parser("graph", help="the element graph: who depends on and talks to whom")
     graph.add_argument("paths", nargs="*", type=Path, metavar="PATH", help="files or folders")
     graph.add_argument("--rev", help="the git revision to draw instead of the files on disk")
-    _add_format(graph, ["dot", "mermaid", "json"])
+    add_format(graph, ["dot", "mermaid", "json"])
     graph.add_argument(
         "--output",
         "-o",
@@ -380,6 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_exclude(graph)
     add_group(graph)
+    add_allow_raised_limits(graph)
     docs = commands.add_parser(
         "docs", help="the documentation installed with archmetrics: list the pages, print one"
     )

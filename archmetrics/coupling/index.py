@@ -202,7 +202,7 @@ class LazyFacts(Mapping[str, FileFacts]):
 
 def dependents_of(deps: Mapping[str, Sequence[Dep]]) -> Mapping[str, Sequence[str]]:
     """For every file depended on, the files that include or import it (a table read from
-    the cache answers from its columns, statecodec.DepTable)."""
+    the cache answers from its columns, sources/deptable.py)."""
     sources = getattr(deps, "sources", None)
     if callable(sources):
         found: Mapping[str, Sequence[str]] = sources()

@@ -11,19 +11,33 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import os
-import stat
 import tomllib
 from collections.abc import Iterable
+from dataclasses import dataclass
 from importlib import metadata, resources
 from importlib.resources.abc import Traversable
-from pathlib import Path
 
 from archmetrics.coupling.rules import RulePack, RulePackError, RuleSet
 from archmetrics.coupling.validate import parse_pack
+from archmetrics.reading import TooLarge, read_regular
 
 ENTRY_POINT_GROUP = "archmetrics.rulepacks"
 
-PackSource = str | os.PathLike[str] | Traversable
+
+
+@dataclass(frozen=True, slots=True)
+class PackBytes:
+    """A pack read already, e.g. from a git revision's blob: ``name`` is what errors and
+    reports call it (``v1:packs/ours.toml``)."""
+
+    name: str
+    data: bytes
+
+    def __str__(self) -> str:
+        return self.name
+
+
+PackSource = str | os.PathLike[str] | Traversable | PackBytes
 
 
 def builtin_pack_files() -> tuple[Traversable, ...]:
@@ -38,10 +52,15 @@ def load_rule_pack(source: PackSource) -> RulePack:
     name = str(source)
     try:
         if isinstance(source, str | os.PathLike):  # a file, not a resource in a package
-            source = Path(source)
-            if _regular_file_size(source) > MAX_PACK_BYTES:
-                raise RulePackError(name, None, None, f"larger than {MAX_PACK_BYTES} bytes")
-        text = source.read_text("utf-8")
+            text = read_regular(source, MAX_PACK_BYTES).decode("utf-8")
+        elif isinstance(source, PackBytes):
+            if len(source.data) > MAX_PACK_BYTES:
+                raise TooLarge(name, len(source.data), MAX_PACK_BYTES)
+            text = source.data.decode("utf-8")
+        else:
+            text = source.read_text("utf-8")
+    except TooLarge:
+        raise RulePackError(name, None, None, f"larger than {MAX_PACK_BYTES} bytes") from None
     except (OSError, UnicodeDecodeError) as error:
         raise RulePackError(name, None, None, f"cannot read the pack: {error}") from error
     try:
@@ -56,15 +75,6 @@ def load_rule_pack(source: PackSource) -> RulePack:
 
 MAX_PACK_BYTES = 1 << 20
 """A rule pack larger than this (1 MiB) is refused: packs are a few kilobytes."""
-
-
-def _regular_file_size(path: Path) -> int:
-    """The size of ``path``; OSError unless it is a regular file (a FIFO or ``/dev/zero``
-    would never finish reading)."""
-    info = path.stat()
-    if not stat.S_ISREG(info.st_mode):
-        raise OSError(f"{path}: not a regular file")
-    return info.st_size
 
 
 def _is_source(value: object) -> bool:

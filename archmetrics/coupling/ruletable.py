@@ -13,6 +13,7 @@ from archmetrics.coupling.rules import (
     RulePack,
     RuleSet,
 )
+from archmetrics.markup import code_span, table_cell
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,12 +116,10 @@ def rule_rows(rules: RuleSet) -> tuple[RuleRow, ...]:
     )
 
 
-def _cell(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ") or "-"
-
-
 def _code(text: str) -> str:
-    return f"`{_cell(text)}`" if text not in ("", "-") else "-"
+    """A cell: the pack's text as a code span (packs come from the repository:
+    archmetrics.markup), or ``-`` for none."""
+    return table_cell(code_span(text)) if text not in ("", "-") else "-"
 
 
 def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
@@ -128,7 +127,8 @@ def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
     lines: list[str] = []
     header = "| rule | language | match | kind | role | endpoint | requires |"
     for pack in rules.packs:
-        lines += [f"{heading} `{pack.name}`", "", pack.description, "", header,
+        description = code_span(pack.description)
+        lines += [f"{heading} {code_span(pack.name)}", "", description, "", header,
                   "|---|---|---|---|---|---|---|"]  # fmt: skip
         for row in (*map(rule_row, pack.rules), *map(config_row, pack.configuration)):
             cells = (row.rule, row.language, row.match, row.kind, row.role, row.endpoint,
@@ -147,6 +147,7 @@ def _place(place: Place | None) -> str:
         f"arg {place.arg}" if place.arg is not None else "",
         f"{place.keyword}=" if place.keyword else "",
         f"{place.value!r}" if place.value is not None else "",
+        f"else callback arg {place.callback}" if place.callback is not None else "",
     ]
     return " / ".join(p for p in parts if p)
 
@@ -154,13 +155,13 @@ def _place(place: Place | None) -> str:
 def _names_and_values(pack: RulePack) -> list[str]:
     """A pack's ``[[scopes]]`` and ``[[values]]``, a line each (they find no sites)."""
     lines = [
-        f"- scope `{s.id}` ({s.kind}, {', '.join(s.languages)}): "
-        f"`{', '.join(s.match)}`, name {_place(s.name)}, namespace {_place(s.namespace)}"
+        f"- scope {code_span(s.id)} ({s.kind}, {', '.join(s.languages)}): "
+        f"{code_span(', '.join(s.match))}, name {_place(s.name)}, namespace {_place(s.namespace)}"
         for s in pack.scopes
     ]
     lines += [
-        f"- value `{v.id}` ({', '.join(v.languages)}): `{', '.join(v.match)}`, value "
-        f"{_place(v.value)}, parameter {_place(v.name)}"
+        f"- value {code_span(v.id)} ({', '.join(v.languages)}): "
+        f"{code_span(', '.join(v.match))}, value {_place(v.value)}, parameter {_place(v.name)}"
         + (f", written into arg {v.out}" if v.out is not None else "")
         for v in pack.values
     ]

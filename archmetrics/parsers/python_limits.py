@@ -93,6 +93,13 @@ def too_deep_for_ast(
         )
     elif kind == "depth" and found.depth > depth:
         message = f"Python source nested {found.depth:,} levels deep; {_limit(depth, limits)}"
+    elif kind == "memory" and found.depth < _PARSER_STACK_DEPTH:  # memory itself ran out
+        lines = source.count("\n") + (not source.endswith("\n"))
+        message = (
+            f"Python source of {lines:,} lines and {len(source):,} characters: the interpreter's"
+            " parser ran out of memory (MemoryError) within the worker's memory limit (raise"
+            " limits.worker-memory-mb, or lower limits.file-mb, to measure or skip it sooner)"
+        )
     else:  # the interpreter's own parser stopped short of our limit
         cause = "MemoryError" if kind == "memory" else "RecursionError"
         message = (
@@ -100,6 +107,11 @@ def too_deep_for_ast(
             f" parser takes ({cause}; it stops near 6,000 nested conditional expressions)"
         )
     return not_measured(path, Language.PYTHON, found.line, message)
+
+
+_PARSER_STACK_DEPTH = 1_000
+"""Nesting below which a MemoryError of the interpreter's parser is memory running out, not
+its own stack (that gives out near 6,000 nested conditional expressions)."""
 
 
 def _limit(depth: int, limits: ParseLimits) -> str:

@@ -56,8 +56,15 @@ def render_dot(graph: ElementGraph) -> str:
     return "\n".join(lines) + "\n"
 
 
+_MERMAID_CODES = {"#": "#35;", '"': "#quot;", "<": "#60;", ">": "#62;", "&": "#38;", "`": "#96;",
+                  "\n": "#92;n", "\r": "#92;r", "\t": "#92;t"}  # fmt: skip
+
+
 def _mermaid_text(text: str) -> str:
-    return '"' + text.replace('"', "#quot;") + '"'
+    """A quoted Mermaid label: every character Mermaid or the HTML it renders would read
+    (an entity's ``#``, quotes, ``<``, ``>``, ``&``, a markdown string's backtick, line
+    breaks) written as Mermaid's entity code, so a name is only ever text."""
+    return '"' + "".join(_MERMAID_CODES.get(char, char) for char in text) + '"'
 
 
 def render_mermaid(graph: ElementGraph) -> str:

@@ -5,13 +5,19 @@ from __future__ import annotations
 import heapq
 import json
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Collection, Iterable, Mapping
 from operator import itemgetter
 from typing import Any
 
 from archmetrics import __version__
 from archmetrics.changeset.accuracy import Accuracy
-from archmetrics.changeset.gates import is_unit_gate, measured_values, parse_gate
+from archmetrics.changeset.gates import (
+    UNMEASURED_GATE,
+    UnmeasuredFailure,
+    is_unit_gate,
+    measured_values,
+    parse_gate,
+)
 from archmetrics.changeset.model import ChangeReport, Summary
 from archmetrics.complexity import FileMetrics, Totals
 from archmetrics.complexity.thresholds import ThresholdFailure
@@ -181,16 +187,30 @@ def diff_dict(report: DiffReport) -> dict[str, Any]:
         "elements": element_records(report.change),
         "excluded": [x.to_dict() for x in report.change.excluded],
         "warnings": [warning_dict(w) for w in report.warnings],
-        "gates": [
-            {**unit_gate(g, report), "values": {}}
-            if is_unit_gate(g)
-            else {"gate": g, "failed": g in failed, "values": gate_values(g, summaries)}
-            for g in report.gates
-        ],
+        "gates": [_gate_record(g, report, failed, summaries) for g in report.gates],
         "base_commit": report.commits[0],
         "head_commit": report.commits[1],
         "tool": {"name": "archmetrics", "version": __version__},
+        "unmeasured": [
+            {"path": path, "reason": why}
+            for failure in report.failures
+            if isinstance(failure, UnmeasuredFailure)
+            for path, why in failure.files
+        ],
     }
+
+
+def _gate_record(
+    gate: str, report: DiffReport, failed: Collection[str], summaries: Mapping[str, Summary]
+) -> dict[str, Any]:
+    """A diff gate's entry: a unit gate's units, a location gate's measured values, the
+    implicit unmeasured(head) gate's count of files left unmeasured."""
+    if is_unit_gate(gate):
+        return {**unit_gate(gate, report), "values": {}}
+    if gate == UNMEASURED_GATE:
+        left = sum(len(f.files) for f in report.failures if isinstance(f, UnmeasuredFailure))
+        return {"gate": gate, "failed": gate in failed, "values": {"unmeasured(head)": left}}
+    return {"gate": gate, "failed": gate in failed, "values": gate_values(gate, summaries)}
 
 
 def gate_values(text: str, summaries: Mapping[str, Summary]) -> dict[str, float | None]:

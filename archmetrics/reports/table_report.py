@@ -26,10 +26,16 @@ from archmetrics.reports.printable import shown_lines, shown_warnings
 
 def to_text(*renderables: object, color: bool = False, width: int | None = None) -> str:
     """Render rich objects to a string (ANSI colours only when ``color``), as wide as the
-    terminal, or 160 columns when there is none."""
+    terminal, or 160 columns when there is none. Text is shown as it is: no rich markup
+    or emoji code in a name is read as one."""
     width = width or terminal_width()
     out = io.StringIO()
-    console = Console(file=out, force_terminal=color, width=width, no_color=not color)
+    # names come from the measured repository: rich must not read them as its markup
+    # ("[link=...]" is a terminal hyperlink, "[bold]" disappears) or emoji codes
+    console = Console(
+        file=out, force_terminal=color, width=width, no_color=not color, markup=False,
+        emoji=False,
+    )  # fmt: skip
     for item in renderables:
         console.print(item)
     return out.getvalue()

@@ -3,6 +3,7 @@
 Everything here reads; nothing here changes a repository, its index or its working tree.
 """
 
+from archmetrics.sources.checkout import open_snapshot
 from archmetrics.sources.snapshot import (
     EMPTY,
     INDEX,
@@ -10,7 +11,6 @@ from archmetrics.sources.snapshot import (
     Snapshot,
     SourceError,
     SourceFile,
-    open_snapshot,
 )
 
 __all__ = ["EMPTY", "INDEX", "WORKTREE", "Snapshot", "SourceError", "SourceFile", "open_snapshot"]

@@ -89,6 +89,19 @@ class Checkout:
 
         return frozenset() if self.repo is None else git.staged_paths(self.repo)
 
+    def file_at(self, spec: str, path: str, limit: int) -> bytes | None:
+        """The bytes of the file ``path`` (POSIX, from the top) at ``spec`` (a revision or
+        INDEX), None when there is none (``EMPTY``, a repository with no commit yet, or no
+        such file); SourceError for a symbolic link, a submodule or a file over ``limit``
+        bytes (revision_files.py)."""
+        from archmetrics.sources import git
+        from archmetrics.sources.revision_files import file_at
+
+        if self.repo is None or spec == EMPTY or git.effective_spec(self.repo, spec) == EMPTY:
+            return None
+        commit = INDEX if spec == INDEX else git.resolve(self.repo, spec)
+        return file_at(self.repo, commit, path, limit, spec)
+
     def tags(self) -> tuple[str, ...]:
         """The repository's tags, oldest first (``git.tags_in_order``)."""
         from archmetrics.sources import git
@@ -107,3 +120,20 @@ def open_checkout(path: Path) -> Checkout:
     if repo is None:
         return Checkout(path if path.is_dir() or not path.exists() else path.parent)
     return Checkout(git.toplevel(repo), repo)
+
+
+def open_snapshot(root: Path, spec: str | None) -> Snapshot:
+    """The snapshot ``spec`` names in the repository or directory at ``root``.
+
+    ``spec`` is None (the files on disk), ``EMPTY``, ``WORKTREE``, ``INDEX`` or any git revision.
+    A command that needs several opens the repository once
+    (:func:`open_checkout`) and asks it for each.
+    """
+    if spec == EMPTY:
+        return EmptySnapshot()
+    if spec is None:
+        from archmetrics.sources import git
+
+        if not git.is_repository(root):
+            return Checkout(root).snapshot(None)
+    return open_checkout(root).snapshot(spec)

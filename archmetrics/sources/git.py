@@ -3,11 +3,13 @@
 Blobs are read through GitPython's object database, which keeps one long-lived
 ``git cat-file --batch`` process per repository instead of one subprocess per file.
 
-Nothing here writes to the repository, and nothing here reaches the network: every git
-command runs with :data:`READ_ONLY`, so git neither refreshes the index's stat cache (which
-rewrites ``.git/index`` and takes ``index.lock``) nor fetches objects a partial clone left
-out. A revision or object that is not in the clone is a one-line :class:`SourceError`
-saying so and how to fetch it (docs/security.md).
+Nothing here writes to the repository, reaches the network or runs a program the
+repository's configuration names: every git command runs with
+:func:`~archmetrics.sources.gitenv.safe_environment`, so git neither refreshes the index's
+stat cache (which rewrites ``.git/index`` and takes ``index.lock``), nor fetches objects a
+partial clone left out, nor runs ``core.fsmonitor``, filters or hooks. A revision or
+object that is not in the clone is a one-line :class:`SourceError` saying so and how to
+fetch it (docs/security.md).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from archmetrics.sources.gitdelta import (
     index_delta,
     worktree_delta,
 )
+from archmetrics.sources.gitenv import safe_environment
+from archmetrics.sources.giterrors import explain, is_shallow
 from archmetrics.sources.paths import quote_path
 from archmetrics.sources.snapshot import (
     EMPTY,
@@ -34,14 +38,6 @@ from archmetrics.sources.snapshot import (
 )
 
 EMPTY_TREE = "4b825dc642cb6eb9a060e54bf8d69288fbee4904"
-
-READ_ONLY = {
-    "GIT_OPTIONAL_LOCKS": "0",  # no index refresh, no index.lock
-    "GIT_NO_LAZY_FETCH": "1",  # a partial clone's missing objects are not fetched (git 2.44+)
-    "GIT_ALLOW_PROTOCOL": "",  # ... nor by older git: no transport is allowed at all
-    "GIT_TERMINAL_PROMPT": "0",  # never wait for a password
-}
-"""The environment of every git command archmetrics runs."""
 
 
 def is_repository(path: Path) -> bool:
@@ -55,7 +51,7 @@ def is_repository(path: Path) -> bool:
 
 
 def open_repository(path: Path) -> git.Repo:
-    """The repository holding ``path``, its git commands set to :data:`READ_ONLY`."""
+    """The repository holding ``path``, its git commands set to a safe environment."""
     repo = find_repository(path)
     if repo is None:
         if not path.exists():
@@ -65,19 +61,24 @@ def open_repository(path: Path) -> git.Repo:
 
 
 def find_repository(path: Path) -> git.Repo | None:
-    """The repository holding ``path`` (its git commands set to :data:`READ_ONLY`), or None
-    when no repository holds it; SourceError when one does but git cannot read it."""
+    """The repository holding ``path`` (its git commands set to the environment of
+    :func:`~archmetrics.sources.gitenv.safe_environment`: read-only, offline, no program of
+    the repository's configuration), or None when no repository holds it; SourceError when
+    one does but git cannot read it."""
     try:
         repo = git.Repo(path, search_parent_directories=True)
     except (InvalidGitRepositoryError, NoSuchPathError):
         return None
     except OSError as error:  # a symbolic-link loop, a folder we may not read
         raise SourceError(f"{path}: cannot read: {error.strerror or error}") from error
-    repo.git.update_environment(**READ_ONLY)
+    repo.git.update_environment(**safe_environment())
     try:  # git's own checks (ownership, a broken .git) fail here, not halfway through
         repo.git.execute(["git", "rev-parse", "--git-dir"])
+        names: str = repo.git.execute(["git", "config", "--list", "--name-only", "-z"])
     except GitCommandError as error:
         raise explain(repo, error, str(path)) from error
+    # the filter and diff drivers the configuration defines, each one's programs disabled
+    repo.git.update_environment(**safe_environment(names.split("\0")))
     return repo
 
 
@@ -85,33 +86,6 @@ def toplevel(repo: git.Repo) -> Path:
     if repo.working_tree_dir is None:
         raise SourceError(f"{repo.git_dir}: a bare repository has no working tree")
     return Path(repo.working_tree_dir)
-
-
-def explain(repo: git.Repo, error: GitCommandError, doing: str) -> SourceError:
-    """A one-line error for a git command that failed, saying why where git says it."""
-    stderr = str(error.stderr or "")
-    if "dubious ownership" in stderr:
-        where = repo.working_tree_dir or repo.git_dir
-        return SourceError(
-            f"{where}: git refuses to read a repository owned by another user; if you trust "
-            f"it: git config --global --add safe.directory {where}"
-        )
-    if "promisor remote" in stderr or "lazy fetching disabled" in stderr:
-        return SourceError(
-            f"{doing}: the object is not in this partial clone and archmetrics does not fetch; "
-            "fetch it first (e.g. git fetch --refetch, or clone without --filter)"
-        )
-    if _is_shallow(repo):
-        return SourceError(
-            f"{doing}: not in this shallow clone; fetch the history first "
-            "(git fetch --unshallow, or fetch-depth: 0 in CI)"
-        )
-    last = stderr.strip().splitlines()[-1] if stderr.strip() else f"exit {error.status}"
-    return SourceError(f"{doing}: git failed: {last.removeprefix('stderr: ').strip()}")
-
-
-def _is_shallow(repo: git.Repo) -> bool:
-    return (Path(repo.git_dir) / "shallow").is_file()
 
 
 def resolve(repo: git.Repo, rev: str) -> str:
@@ -122,7 +96,7 @@ def resolve(repo: git.Repo, rev: str) -> str:
             ["git", "rev-parse", "--verify", "--quiet", "--end-of-options", f"{rev}^{{commit}}"]
         )
     except GitCommandError as error:
-        if _is_shallow(repo):
+        if is_shallow(repo):
             raise SourceError(
                 f"unknown revision {rev!r} in this shallow clone: if it is older than the "
                 "clone's depth, fetch the history first (git fetch --unshallow, or "
@@ -144,7 +118,7 @@ def merge_base(repo: git.Repo, first: str, second: str) -> str:
     except GitCommandError as error:
         if error.status != 1 or str(error.stderr or "").strip():
             raise explain(repo, error, f"the merge base of {first} and {second}") from error
-        if _is_shallow(repo):
+        if is_shallow(repo):
             raise SourceError(
                 f"{first} and {second}: no merge base in this shallow clone; fetch the history"
                 " first (git fetch --deepen=200, or --unshallow; fetch-depth: 0 in CI)"
@@ -192,6 +166,15 @@ def _ls(repo: git.Repo, *args: str) -> list[str]:
 class _BlobReader:
     def __init__(self, repo: git.Repo):
         self.repo = repo
+
+    def size(self, file: SourceFile) -> int | None:
+        """The blob's size, asked of git's long-lived ``cat-file --batch-check`` without
+        reading the blob (a file over the size limit is never read); None if git cannot
+        tell (reading it will say why)."""
+        try:
+            return int(self.repo.odb.info(bytes.fromhex(file.blob)).size)
+        except (GitCommandError, ValueError, GitError):
+            return None
 
     def read(self, file: SourceFile) -> bytes:
         try:

@@ -3,7 +3,8 @@ the files added or changed (with their blobs where git knows them), the files go
 renames. A diff whose base state is known patches it with these instead of listing and
 reading the whole head tree (app/tree.py, docs/performance.md "Incremental diffs").
 
-Like every git command archmetrics runs, these run with ``READ_ONLY`` (git.py): plumbing
+Like every git command archmetrics runs, these run in the repository's safe environment
+(gitenv.py: read-only, no program of the repository's configuration): plumbing
 that compares without refreshing or writing the index. The commands a work tree needs run at
 once, as git's own processes, while the caller goes on.
 """
@@ -58,7 +59,7 @@ class _Git:
     def finish(self, started: tuple[list[str], subprocess.Popen[bytes]]) -> bytes:
         from git.exc import GitCommandError
 
-        from archmetrics.sources.git import explain
+        from archmetrics.sources.giterrors import explain
 
         command, process = started
         out, err = process.communicate()

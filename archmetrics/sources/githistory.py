@@ -70,7 +70,7 @@ def _failed(repo: gitpython.Repo, command: list[str], status: int, err: bytes) -
     its last lines are usage), or what :func:`explain` makes of the error."""
     from git.exc import GitCommandError
 
-    from archmetrics.sources.git import explain
+    from archmetrics.sources.giterrors import explain
 
     error = explain(repo, GitCommandError(command, status, err), f"git {command[1]}")
     fatal = [line for line in err.decode("utf-8", "replace").splitlines()

@@ -14,9 +14,11 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from archmetrics.sources.git import READ_ONLY
+from archmetrics.reading import TooLarge, read_regular
+from archmetrics.sources.gitenv import READ_ONLY
 from archmetrics.sources.snapshot import (
     DirectorySnapshot,
+    Sized,
     Snapshot,
     SourceError,
     SourceFile,
@@ -41,6 +43,12 @@ class OverlaySnapshot:
     def read(self, file: SourceFile) -> bytes:
         data = self.changes.get(file.path)
         return data if data is not None else self.base.read(file)
+
+    def size(self, file: SourceFile) -> int | None:
+        data = self.changes.get(file.path)
+        if data is not None:
+            return len(data)
+        return self.base.size(file) if isinstance(self.base, Sized) else None
 
 
 def stubs_overlay(base: Snapshot, folder: Path, label: str) -> OverlaySnapshot:
@@ -92,12 +100,13 @@ def _touched(numstat: bytes) -> list[str]:
 def patch_overlay(base: Snapshot, patch_file: Path, label: str) -> OverlaySnapshot:
     """``base`` with the unified diff in ``patch_file`` applied (as ``git apply`` does)."""
     try:
-        with patch_file.open("rb") as stream:
-            patch = stream.read(MAX_PATCH_BYTES + 1)
+        patch = read_regular(patch_file, MAX_PATCH_BYTES)
+    except TooLarge:
+        raise SourceError(
+            f"{patch_file}: a patch may hold at most {MAX_PATCH_BYTES} bytes"
+        ) from None
     except OSError as error:
         raise SourceError(f"{patch_file}: cannot read: {error.strerror or error}") from None
-    if len(patch) > MAX_PATCH_BYTES:
-        raise SourceError(f"{patch_file}: a patch may hold at most {MAX_PATCH_BYTES} bytes")
     by_path = {f.path: f for f in base.files()}
     with tempfile.TemporaryDirectory(prefix="archmetrics-sketch-") as scratch:
         folder = Path(scratch) / "tree"

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from archmetrics.globs import gitignore_file
+from archmetrics.reading import read_regular
 from archmetrics.sources.paths import quote_path
 
 if TYPE_CHECKING:
@@ -144,10 +145,12 @@ class DirectorySnapshot:
         return tuple(found)
 
     def read(self, file: SourceFile) -> bytes:
+        """The file's bytes: a regular file's, never a symbolic link's target, never a FIFO
+        or device put there since the tree was listed."""
         try:
-            return (self.root / self._on_disk.get(file.path, file.path)).read_bytes()
+            return read_regular(self.root / self._on_disk.get(file.path, file.path), follow=False)
         except OSError as error:
-            raise SourceError(f"{file.path}: cannot read: {error.strerror}") from error
+            raise SourceError(f"{file.path}: cannot read: {error.strerror or error}") from error
 
     def size(self, file: SourceFile) -> int | None:
         """The file's size on disk, None if it cannot be asked (it is read later, and a
@@ -221,9 +224,8 @@ class _Ignores:
 
 def _read_gitignore(path: Path) -> GitIgnoreSpec | None:
     try:
-        if not path.is_file() or path.is_symlink() or path.stat().st_size > _GITIGNORE_BYTES:
-            return None
-        lines = path.read_text("utf-8", "surrogateescape").splitlines()[:_GITIGNORE_LINES]
+        data = read_regular(path, _GITIGNORE_BYTES, follow=False)
+        lines = data.decode("utf-8", "surrogateescape").splitlines()[:_GITIGNORE_LINES]
         return gitignore_file(lines)  # matched by RE2: a hostile pattern cannot backtrack
     except (OSError, ValueError):
         return None
@@ -247,22 +249,3 @@ def _walk_order(path: str) -> list[tuple[int, str]]:
     subfolders, each in name order."""
     *folders, name = path.split("/")
     return [(1, folder) for folder in folders] + [(0, name)]
-
-
-def open_snapshot(root: Path, spec: str | None) -> Snapshot:
-    """The snapshot ``spec`` names in the repository or directory at ``root``.
-
-    ``spec`` is None (the files on disk), ``EMPTY``, ``WORKTREE``, ``INDEX`` or any git revision.
-    A command that needs several opens the repository once
-    (:func:`~archmetrics.sources.checkout.open_checkout`) and asks it for each.
-    """
-    from archmetrics.sources.checkout import Checkout, open_checkout
-
-    if spec == EMPTY:
-        return EmptySnapshot()
-    if spec is None:
-        from archmetrics.sources import git
-
-        if not git.is_repository(root):
-            return Checkout(root).snapshot(None)
-    return open_checkout(root).snapshot(spec)

@@ -7,14 +7,14 @@ The record is flat columns, files named by their position and names of a few kin
 language, a resolution, a role, a location) by theirs in a table: reading a numpy-sized
 state is a few list checks in C (every number's type and range, every text's type), not a
 check per field, and the coupling index's dependency records are made only for the files a
-patch reads (:class:`DepTable`).
+patch reads (sources/deptable.py).
 """
 
 from __future__ import annotations
 
 import json
 import zlib
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from itertools import accumulate, repeat
 from typing import Any
 
@@ -24,15 +24,37 @@ from archmetrics.changeset.rows import FileRow
 from archmetrics.changeset.state import TreeState
 from archmetrics.changeset.unchanged import ElementRow
 from archmetrics.coupling.elements import Element
-from archmetrics.coupling.index import CouplingIndex, Dep, Site, Values
+from archmetrics.coupling.index import CouplingIndex, Site, Values
 from archmetrics.facts import ParseWarning, Severity
 from archmetrics.sources.codec import CodecError
+from archmetrics.sources.deptable import RESOLUTIONS as _RESOLUTIONS
+from archmetrics.sources.deptable import DepTable
+from archmetrics.sources.statecolumns import (
+    bad as _bad,
+)
+from archmetrics.sources.statecolumns import (
+    ints as _ints,
+)
+from archmetrics.sources.statecolumns import (
+    lists as _lists,
+)
+from archmetrics.sources.statecolumns import (
+    lists_of as _lists_of,
+)
+from archmetrics.sources.statecolumns import (
+    loads as _loads,
+)
+from archmetrics.sources.statecolumns import (
+    split as _split,
+)
+from archmetrics.sources.statecolumns import (
+    texts as _texts,
+)
 
 FORMAT = 4
 _PARSED, _GENERATED = 1, 2
 _SEVERITIES = tuple(s.value for s in Severity)
 _SEVERITY_MEMBERS = tuple(Severity)
-_RESOLUTIONS = ("internal", "external", "unresolved")
 _ROLES = ("initiate", "receive", "use", "also")
 _LOCATIONS = tuple(loc for loc in Location)
 
@@ -152,55 +174,6 @@ def _table_columns(state: TreeState, at: Mapping[str, int]) -> list[Any]:
 _new = tuple.__new__  # a named tuple from its fields, without its class's Python-level __new__
 
 
-def _loads(text: bytes) -> Any:
-    import orjson
-
-    try:
-        return orjson.loads(text)
-    except orjson.JSONDecodeError:  # an escaped lone surrogate: orjson refuses it, json reads it
-        return json.loads(text)
-
-
-def _bad(what: str) -> CodecError:
-    return CodecError(f"a tree state with {what}")
-
-
-def _ints(value: object, low: int, high: int, count: int | None = None) -> list[int]:
-    """A list of integers in [low, high) (``count`` of them, if given)."""
-    if not isinstance(value, list) or not set(map(type, value)) <= {int}:
-        raise _bad("a list that is not integers")
-    if value and (min(value) < low or max(value) >= high):
-        raise _bad("a number out of range")
-    if count is not None and len(value) != count:
-        raise _bad("columns of different lengths")
-    return value
-
-
-def _texts(value: object, count: int | None = None, none: bool = False) -> list[Any]:
-    """A list of texts (``none``: or nulls)."""
-    allowed = {str, type(None)} if none else {str}
-    if not isinstance(value, list) or not set(map(type, value)) <= allowed:
-        raise _bad("a list that is not texts")
-    if count is not None and len(value) != count:
-        raise _bad("columns of different lengths")
-    return value
-
-
-def _lists(value: object, count: int) -> list[Any]:
-    if not isinstance(value, list) or len(value) != count:
-        raise _bad("a malformed section")
-    return value
-
-
-def _split(flat: Sequence[Any], sizes: Sequence[int]) -> Iterator[Sequence[Any]]:
-    if sum(sizes) != len(flat):
-        raise _bad("lengths that do not add up")
-    start = 0
-    for end in accumulate(sizes):
-        yield flat[start:end]
-        start = end
-
-
 def decode(data: bytes) -> TreeState:
     """The state ``encode`` wrote; :class:`CodecError` for anything else."""
     try:
@@ -289,12 +262,6 @@ def _regrouped(
     return groups
 
 
-def _lists_of(value: object) -> list[Any]:
-    if not isinstance(value, list) or not all(isinstance(v, list) for v in value):
-        raise _bad("a malformed section")
-    return value
-
-
 def _grouped(names: list[str], members: object, sizes: object, files: list[str],
              kinds: Sequence[tuple[str, ...]]) -> tuple[Element, ...]:  # fmt: skip
     count = len(files)
@@ -354,65 +321,6 @@ def _sites(value: object, files: list[str]) -> dict[str, tuple[Site, ...]]:
         files[i]: tuple((_ROLES[role], key) for role, key in span)
         for i, span in zip(located, spans, strict=True)
     }
-
-
-class DepTable(Mapping[str, tuple[Dep, ...]]):
-    """The coupling index's dependency records of a state read from the cache, kept as the
-    columns they were read from; a file's records are made when asked for."""
-
-    def __init__(self, files: list[str], where: list[int], starts: list[int],
-                 targets: list[int], resolutions: list[int], names: list[str]) -> None:  # fmt: skip
-        self.files, self.where, self.starts = files, where, starts
-        self.targets, self.resolutions, self.names = targets, resolutions, names
-        self._span: dict[str, tuple[int, int]] | None = None
-        self._made: dict[str, tuple[Dep, ...]] = {}
-
-    @classmethod
-    def read(cls, value: object, files: list[str]) -> DepTable:
-        where, sizes, targets, resolutions, names = _lists(value, 5)
-        located = _ints(where, 0, len(files))
-        lengths = _ints(sizes, 1, 1 << 62, len(located))
-        target = _ints(targets, -1, len(files))
-        if sum(lengths) != len(target) or len(set(located)) != len(located):
-            raise _bad("dependency columns that do not add up")
-        codes = _ints(resolutions, 0, len(_RESOLUTIONS), len(target))
-        return cls(files, located, [0, *accumulate(lengths)], target, codes,
-                   _texts(names, len(target)))  # fmt: skip
-
-    @property
-    def span(self) -> dict[str, tuple[int, int]]:
-        """Each file's records' place in the columns (made when first asked for)."""
-        if self._span is None:
-            starts, files = self.starts, self.files
-            self._span = {files[i]: (starts[k], starts[k + 1]) for k, i in enumerate(self.where)}
-        return self._span
-
-    def __getitem__(self, path: str) -> tuple[Dep, ...]:
-        made = self._made.get(path)
-        if made is None:
-            start, end = self.span[path]
-            files, targets, codes, names = self.files, self.targets, self.resolutions, self.names
-            made = self._made[path] = tuple(
-                Dep(None if targets[i] < 0 else files[targets[i]], _RESOLUTIONS[codes[i]], names[i])
-                for i in range(start, end)
-            )
-        return made
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.span)
-
-    def __len__(self) -> int:
-        return len(self.where)
-
-    def sources(self) -> dict[str, list[str]]:
-        """For every file depended on, the files that include or import it."""
-        found: dict[int, list[str]] = {}
-        files, targets, starts = self.files, self.targets, self.starts
-        for k, i in enumerate(self.where):
-            for t in targets[starts[k] : starts[k + 1]]:
-                if t >= 0:
-                    found.setdefault(t, []).append(files[i])
-        return {files[t]: sources for t, sources in found.items()}
 
 
 def _table(value: object, groups: Sequence[Element], files: list[str]) -> dict[str, ElementRow]:

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.scan import ScanRequest, run_scan
 from archmetrics.cli import main
 from archmetrics.config import load_settings
@@ -75,12 +76,11 @@ def test_each_trees_coupling_is_kept_and_served_byte_for_byte(
 def test_a_setting_that_changes_coupling_is_another_key(history: GitRepo, tmp_path: Path) -> None:
     cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
     before = _diff(history, tmp_path, *cache)
-    (history.root / "archmetrics.toml").write_text(
-        '[tool.archmetrics.coupling]\nignore-imports = ["__future__", "shared"]\n'
-    )
-    plain = _diff(history, tmp_path, "--no-cache")
+    config = history.root / "archmetrics.toml"  # not committed: the runner's file
+    config.write_text('[tool.archmetrics.coupling]\nignore-imports = ["__future__", "shared"]\n')
+    plain = _diff(history, tmp_path, "--no-cache", "--config-from", str(config))
     assert plain != before  # the import of shared no longer counts
-    assert _diff(history, tmp_path, *cache) == plain
+    assert _diff(history, tmp_path, *cache, "--config-from", str(config)) == plain
     assert len(_totals(tmp_path / "cache.sqlite3")) == 4
 
 
@@ -257,8 +257,9 @@ def test_a_generated_file_is_read_no_further_than_its_first_lines(
     assert " 0 parsed;" in capsys.readouterr().err
     # asked to count generated files, the diff reads it whole: its function and the
     # region it could not parse
-    (repo.root / "archmetrics.toml").write_text("[tool.archmetrics]\ninclude-generated = true\n")
-    counted = json.loads(_diff(repo, tmp_path, *cache))
+    config = repo.root / "archmetrics.toml"  # not committed: the runner's file
+    config.write_text("[tool.archmetrics]\ninclude-generated = true\n")
+    counted = json.loads(_diff(repo, tmp_path, *cache, "--config-from", str(config)))
     assert "gen.c" not in [x["path"] for x in counted["excluded"]]
     assert [w for w in counted["warnings"] if "gen.c" in json.dumps(w)]
     gen = next(e for e in counted["elements"] if e["element"] == "gen")

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from archmetrics.app.collect import open_cache
-from archmetrics.app.diff import DiffRequest
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.history import HistoryRequest, run_history
 from archmetrics.cli import main
 from archmetrics.config import load_settings

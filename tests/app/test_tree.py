@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from archmetrics.app.diff import DiffRequest, run_diff
+from archmetrics.app.diff import run_diff
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.cli import main
 from archmetrics.config import load_settings
 from archmetrics.sources.cache import FactsCache

@@ -84,6 +84,7 @@ def _measured(out: str) -> dict[str, dict[str, object]]:
         ("RAISE", "ZeroDivisionError: the plugin's own bug"),
     ],
 )
+@pytest.mark.security
 def test_a_file_that_breaks_its_parser_costs_that_file(
     repo: GitRepo, plugin: dict[str, str], trigger: str, reason: str, fine: int
 ) -> None:
@@ -98,6 +99,7 @@ def test_a_file_that_breaks_its_parser_costs_that_file(
     assert all(files[f"ok{i}.py"]["vg"] == 2 for i in range(fine))
 
 
+@pytest.mark.security
 def test_a_file_over_the_time_limit_is_cut_off(repo: GitRepo, plugin: dict[str, str]) -> None:
     limits = "[tool.archmetrics.limits]\nfile-seconds = 1\n"
     _repo(repo, {"slow.un": "# SLEEP\n", "also.un": FINE.format(i=7)}, 3, limits)
@@ -111,6 +113,7 @@ def test_a_file_over_the_time_limit_is_cut_off(repo: GitRepo, plugin: dict[str, 
     assert files["also.un"]["vg"] == 2
 
 
+@pytest.mark.security
 def test_a_file_over_the_memory_limit_is_not_measured(
     repo: GitRepo, plugin: dict[str, str]
 ) -> None:
@@ -145,6 +148,7 @@ def test_files_cut_off_by_a_limit_are_not_cached(
         ("pages = 3", "unknown key 'pages'"),
     ],
 )
+@pytest.mark.security
 def test_limits_a_repository_sets_are_checked(repo: GitRepo, limits: str, problem: str) -> None:
     repo.commit("v1", files={"pyproject.toml": f"[tool.archmetrics.limits]\n{limits}\n"})
     run = run_cli(["scan", "."], repo.root)
@@ -183,6 +187,7 @@ def _alive(pids: set[int]) -> set[int]:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 @pytest.mark.parametrize("fine", [3, 60], ids=["forked", "fork-server"])
+@pytest.mark.security
 def test_workers_exit_when_archmetrics_is_killed(
     repo: GitRepo, plugin: dict[str, str], fine: int
 ) -> None:

@@ -121,6 +121,7 @@ def test_a_glob_regex_cannot_compile_is_refused_by_name(pattern: str) -> None:
         ("**/a/" * 200 + "b", "a/" * 20_000 + "c", False),
     ],
 )
+@pytest.mark.security
 def test_globs_with_many_stars_match_without_backtracking(
     pattern: str, path: str, expected: bool
 ) -> None:

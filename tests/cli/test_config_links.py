@@ -35,9 +35,10 @@ def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> Any:
 
 
 def test_a_folder_holding_only_router_rules_has_one_messaging_link(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The reproducer in docs/study.md, "Router rules": one route, one messaging link."""
+    monkeypatch.setenv("COLUMNS", "300")  # every cell whole, however long the temp path
     (tmp_path / "rules.toml").write_text(ONE_ROUTE)
     table = _run(capsys, "scan", "--by", "link", str(tmp_path), "--no-cache")
     row = next(line for line in table.splitlines() if "rules.toml:3" in line)
@@ -98,12 +99,14 @@ def test_the_caches_serve_the_same_links_and_know_the_rule_packs(
         'role = "use"\nendpoint = { type = "operation", key = "operation" }\n',
         "pyproject.toml": '[tool.archmetrics.coupling]\nrule-packs = ["pack.toml"]\n',
     })  # fmt: skip
-    mine = _diff(router, capsys, "--cache-path", cache)
+    config = ["--config-from", str(router.root / "pyproject.toml")]  # not committed
+    mine = _diff(router, capsys, "--cache-path", cache, *config)
     assert mine["locations"]["framework"]["delta_d_e"] == 2  # the route and the operation
     assert main(["cache", "info", "--cache-path", cache]) == 0
     capsys.readouterr()
 
 
+@pytest.mark.security
 def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
     tmp_path: Path,
 ) -> None:
@@ -123,6 +126,7 @@ def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
     assert checksums(tmp_path) == before
 
 
+@pytest.mark.security
 def test_a_huge_rules_file_is_over_the_file_limit_not_read(tmp_path: Path) -> None:
     (tmp_path / "pyproject.toml").write_text("[tool.archmetrics.limits]\nfile-mb = 0.01\n")
     (tmp_path / "rules.toml").write_text(ONE_ROUTE + '\n[[rules]]\nx = "y"\n' * 2_000)

@@ -237,6 +237,7 @@ def test_gates(integration: GitRepo, capsys: pytest.CaptureFixture[str]) -> None
     assert gates == [  # (each entry's `values`: tests/cli/test_merge_base.py)
         {"gate": "cost(new) > 1", "failed": True},
         {"gate": "delta_s_e(base) > 5", "failed": False},
+        {"gate": "unmeasured(head) > 0", "failed": False},  # every gated diff's own
     ]
     assert main(["diff", "-C", str(integration.root), *args, "--fail-on", "cost(new) > 2"]) == 0
 
@@ -270,7 +271,10 @@ def test_gates_from_config(integration: GitRepo, capsys: pytest.CaptureFixture[s
     integration.write(
         {"archmetrics.toml": 'gates = ["changes > 3"]\n[locations]\nnew = ["wdb/**"]\n'}
     )
-    assert main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2"]) == 1
+    # an uncommitted configuration: neither v1's nor v2's, so named as the runner's file
+    config = ["--config-from", str(integration.root / "archmetrics.toml")]
+    assert main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2"]) == 0
+    assert main(["diff", "-C", str(integration.root), "--base", "v1", "--head", "v2", *config]) == 1
     out, err = capsys.readouterr()
     # the table on stdout names the failed gate; stderr does not repeat it
     assert out.count("gate failed: changes > 3") == 1 and "gate failed" not in err
@@ -435,7 +439,7 @@ def _markdown(repo: GitRepo, capsys: pytest.CaptureFixture[str], *extra: str) ->
 
 
 def _rows(markdown: str) -> list[str]:
-    return [line for line in markdown.splitlines() if line.startswith("| pkg/")]
+    return [line for line in markdown.splitlines() if line.startswith("| `pkg/")]
 
 
 def test_markdown_fits_a_pull_request_comment_and_says_what_it_left_out(

@@ -516,6 +516,7 @@ def test_an_architecture_may_start_from_its_own_base_and_be_chosen_alone(
     assert f"{bad}: architecture.x.base: unknown revision 'nowhere'" in err
 
 
+@pytest.mark.security
 def test_a_sketch_cannot_reach_outside_its_tree(
     sketched: GitRepo, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -52,7 +52,7 @@ def test_the_page_quotes_the_estimate_and_its_ranking(
     study: GitRepo, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = markdown(study, capsys, "--format", "markdown")
-    quoted = [line for line in PAGE.splitlines() if line.startswith("| estimate |")]
+    quoted = [line for line in PAGE.splitlines() if line.startswith("| `estimate` |")]
     assert len(quoted) == 3 and all(line in out.splitlines() for line in quoted)
     rows = [
         line for line in PAGE.splitlines() if line.startswith(("| Γ' | 6.25 |", "| E | 6.37 |"))
@@ -67,7 +67,7 @@ def test_the_page_quotes_each_plans_errors_against_the_measured_stage(
     argv = ["--actual", "--architecture", approach, "--base", f"{approach}-baseline"]
     out = markdown(study, capsys, *argv, "--head", f"{approach}-first", "--format", "markdown")
     printed = {
-        line.replace(f"| {approach} | total |", f"| {approach} |") for line in out.splitlines()
+        line.replace(f"| `{approach}` | total |", f"| `{approach}` |") for line in out.splitlines()
     }
-    quoted = [line for line in PAGE.splitlines() if line.startswith(f"| {approach} | ")]
+    quoted = [line for line in PAGE.splitlines() if line.startswith(f"| `{approach}` | ")]
     assert quoted and all(line in printed for line in quoted)

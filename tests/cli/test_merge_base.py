@@ -59,7 +59,10 @@ def test_three_dots_count_only_the_branch_s_changes(
     assert (three["base"], three["head"]) == ("main...HEAD", "HEAD")
     assert (three["base_commit"], three["head_commit"]) == (merge_base, head)
     assert three["tool"] == {"name": "archmetrics", "version": __version__}
-    assert three["gates"] == [{"gate": "added > 1", "failed": True, "values": {"added(total)": 2}}]
+    assert three["gates"] == [
+        {"gate": "added > 1", "failed": True, "values": {"added(total)": 2}},
+        {"gate": "unmeasured(head) > 0", "failed": False, "values": {"unmeasured(head)": 0}},
+    ]  # a gated diff also checks that the head measures what the base's configuration does
     two = _json(behind, capsys, "--base", "main", "--head", "HEAD")
     assert _counts(two) == (2, 4, 0, -1)  # main's b.py counted as removed by the branch
     flag = _json(behind, capsys, "--base", "main", "--head", "HEAD", "--merge-base")
@@ -84,6 +87,7 @@ def test_a_gate_entry_carries_what_it_measured(
             "values": {"added(total)": 2.0, "cost(new)": 0.0},
         },
         {"gate": "loc_scale(new) > 0", "failed": False, "values": {"loc_scale(new)": None}},
+        {"gate": "unmeasured(head) > 0", "failed": False, "values": {"unmeasured(head)": 0}},
     ]  # nothing new: E(N) = 0 and λ̂(N) undefined (null), so neither gate fails
 
 

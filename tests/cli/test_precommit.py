@@ -138,7 +138,8 @@ def _run(repo: GitRepo, env: dict[str, str], *argv: str) -> subprocess.Completed
 @pytest.mark.timeout(900)
 def test_hook_runs_on_deletions_and_configuration_changes(repo: GitRepo, tmp_path: Path) -> None:
     """A commit that only deletes files, or only edits archmetrics.toml, is measured too (the
-    hook's file filter used to match nothing staged, and pre-commit skipped it)."""
+    hook's file filter used to match nothing staged, and pre-commit skipped it); a gate a
+    commit adds holds from the next commit on."""
     env = _hooked(repo, tmp_path, '"removed > 3"')
     repo.write({"a.py": "".join(f"v{i} = {i}\n" for i in range(5)), "b.py": "x = 1\n"})
     assert _run(repo, env, str(PRE_COMMIT), "install").returncode == 0
@@ -153,8 +154,15 @@ def test_hook_runs_on_deletions_and_configuration_changes(repo: GitRepo, tmp_pat
     repo.write({"archmetrics.toml": 'gates = ["removed > 3", "loc_post < 100"]\n'})
     repo.git("add", "archmetrics.toml")
     configured = _run(repo, env, "git", "commit", "-m", "a stricter gate, nothing else")
-    assert configured.returncode != 0  # the hook ran on a configuration-only commit
-    assert "gate failed: loc_post < 100" in configured.stdout + configured.stderr
+    said = configured.stdout + configured.stderr
+    # the hook ran on a configuration-only commit (pre-commit says Skipped when it does not),
+    # under the gates of the commit's base: a commit cannot change the gates it is judged by
+    assert configured.returncode == 0 and "Passed" in said and "Skipped" not in said, said
+    repo.write({"b.py": "x = 2\n"})
+    repo.git("add", "b.py")
+    after = _run(repo, env, "git", "commit", "-m", "the next change")  # the new gate holds
+    assert after.returncode != 0
+    assert "gate failed: loc_post < 100" in after.stdout + after.stderr
 
 
 @pytest.mark.slow

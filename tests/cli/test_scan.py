@@ -211,12 +211,12 @@ def test_the_configured_exclude_leaves_files_out_and_lists_them(
     assert "excluded vendor/v.py: exclude:vendor/**" in capsys.readouterr().out
     # every report lists it: Markdown, and the CSV as a row of its own, its reason last
     assert main(["scan", str(repo.root), "-q", "--format", "markdown"]) == 0
-    assert "- excluded `vendor/v.py`: exclude:vendor/**" in capsys.readouterr().out
+    assert "- excluded `vendor/v.py`: `exclude:vendor/**`" in capsys.readouterr().out
     assert main(["scan", str(repo.root), "-q", "--format", "csv"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].endswith(",excluded") and lines[-1] == "vendor/v.py,,,,,,,exclude:vendor/**"
     repo.commit("v2", files={"vendor/v.py": "x = 2\n", "src/p.py": PY_V2 + "z = 1\n"})
-    for fmt, listed in (("markdown", "- excluded `vendor/v.py`: exclude:vendor/**"),
+    for fmt, listed in (("markdown", "- excluded `vendor/v.py`: `exclude:vendor/**`"),
                         ("table", "excluded vendor/v.py: exclude:vendor/**"),
                         ("csv", "excluded,vendor/v.py,")):  # fmt: skip
         argv = ["diff", "-C", str(repo.root), "--base", "HEAD~1", "--head", "HEAD", "-q"]

@@ -7,7 +7,9 @@ from pathlib import Path
 import pytest
 
 from tests.gitrepo import GitRepo
-from tests.untrusted import checksums, run_cli
+from tests.untrusted import checksums, run_main
+
+pytestmark = pytest.mark.security
 
 SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 
@@ -38,7 +40,7 @@ def test_a_cache_path_into_the_repository_is_refused(
 ) -> None:
     _configured(repo, str(repo.root / target))
     before = checksums(repo.root)
-    run = run_cli(["scan", "."], repo.root, env)
+    run = run_main(["scan", "."], repo.root, env)
     assert run.code == 2
     assert "outside archmetrics's cache directory" in run.one_line_error()
     assert checksums(repo.root) == before
@@ -51,7 +53,7 @@ def test_a_cache_path_out_of_the_cache_directory_is_refused(
 ) -> None:
     _configured(repo, target)
     before = checksums(tmp_path)
-    run = run_cli(["scan", "."], repo.root, {**env, "HOME": str(tmp_path / "home")})
+    run = run_main(["scan", "."], repo.root, {**env, "HOME": str(tmp_path / "home")})
     assert run.code == 2
     assert "outside archmetrics's cache directory" in run.one_line_error()
     assert checksums(tmp_path) == before
@@ -62,7 +64,7 @@ def test_a_relative_cache_path_is_a_file_in_the_cache_directory(
 ) -> None:
     _configured(repo, ".git")
     before = checksums(repo.root)
-    run = run_cli(["scan", "."], repo.root, env)
+    run = run_main(["scan", "."], repo.root, env)
     assert run.code == 0, run.err
     assert checksums(repo.root) == before
     assert (Path(env["XDG_CACHE_HOME"]) / "archmetrics" / ".git").is_file()
@@ -73,7 +75,7 @@ def test_the_runners_environment_outranks_the_repositorys_config(
 ) -> None:
     _configured(repo, str(repo.root / ".git"))
     mine = tmp_path / "mine.sqlite3"
-    run = run_cli(["scan", "."], repo.root, {**env, "ARCHMETRICS_CACHE": str(mine)})
+    run = run_main(["scan", "."], repo.root, {**env, "ARCHMETRICS_CACHE": str(mine)})
     assert run.code == 0, run.err
     assert mine.is_file()
 
@@ -85,7 +87,7 @@ def test_the_cache_path_flag_never_overwrites_what_is_not_a_cache(
     repo.commit("v1", files={"pyproject.toml": "[tool.archmetrics]\n", "tracked.py": SOURCE})
     before = checksums(repo.root)
     for argv in (["scan", "."], ["cache", "clear"], ["cache", "info"]):
-        run = run_cli([*argv, "--cache-path", target], repo.root, env)
+        run = run_main([*argv, "--cache-path", target], repo.root, env)
         assert run.code == 2
         assert "facts cache" in run.one_line_error()
     assert checksums(repo.root) == before
@@ -96,6 +98,6 @@ def test_the_cache_path_flag_expands_the_home_directory(
 ) -> None:
     repo.commit("v1", files={"tracked.py": SOURCE})
     home = tmp_path / "home"
-    run = run_cli(["scan", ".", "--cache-path=~/c.sqlite3"], repo.root, {**env, "HOME": str(home)})
+    run = run_main(["scan", ".", "--cache-path=~/c.sqlite3"], repo.root, {**env, "HOME": str(home)})
     assert run.code == 0, run.err
     assert (home / "c.sqlite3").is_file()

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from tests.gitrepo import GitRepo
-from tests.untrusted import run_cli
+from tests.untrusted import run_cli, run_main
 
 SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 
@@ -29,8 +29,11 @@ SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
         ('[tool.archmetrics]\nlanguages = { ".py" = "cobol" }\n', "no parser for language"),
         ("[tool.archmetrics]\ncache-path = '/'\n", "outside archmetrics's cache directory"),
         (b"\xff\xfe[tool]", "not valid TOML"),
+        ("[tool.archmetrics.limits]\nfile-mb = 1e-9\n", "limits.file-mb: expected at least 0.001"),
+        ('[tool.archmetrics]\ncache-path = "\\u0000"\n', "cache-path: expected a path (without"),
     ],
 )
+@pytest.mark.security
 def test_a_bad_configuration_is_one_line(
     repo: GitRepo, config: str | bytes, problem: str, tmp_path: Path
 ) -> None:
@@ -38,20 +41,22 @@ def test_a_bad_configuration_is_one_line(
     repo.write({"a.py": SOURCE + "x = 1\n"})
     env = {"ARCHMETRICS_CACHE": "", "XDG_CACHE_HOME": str(tmp_path / "xdg")}
     for argv in (["scan", "."], ["diff"]):
-        run = run_cli(argv, repo.root, env)
+        run = run_main(argv, repo.root, env)
         assert run.code == 2, (argv, run.err)
         assert problem in run.one_line_error()
 
 
+@pytest.mark.security
 def test_a_symbolic_link_loop_as_an_argument(tmp_path: Path) -> None:
     (tmp_path / "one").symlink_to(tmp_path / "two")
     (tmp_path / "two").symlink_to(tmp_path / "one")
     for argv in (["scan", "one"], ["diff", "-C", "one"], ["graph", "one"]):
-        run = run_cli(argv, tmp_path)
+        run = run_main(argv, tmp_path)
         assert run.code == 2
         assert "one" in run.one_line_error()
 
 
+@pytest.mark.security
 def test_an_unforeseen_error_is_one_line_and_v_shows_the_traceback(
     repo: GitRepo, tmp_path: Path
 ) -> None:
@@ -85,6 +90,7 @@ NAMES = {
 }
 
 
+@pytest.mark.security
 @pytest.mark.parametrize("committed", [True, False], ids=["revision", "worktree"])
 def test_file_names_that_are_not_plain_text_are_escaped_everywhere(
     repo: GitRepo, committed: bool
@@ -94,10 +100,10 @@ def test_file_names_that_are_not_plain_text_are_escaped_everywhere(
     if committed:
         repo.commit("v1")
     for fmt in ("json", "table", "markdown", "csv"):
-        run = run_cli(["scan", ".", "--format", fmt, "--no-cache"], repo.root)
+        run = run_main(["scan", ".", "--format", fmt, "--no-cache"], repo.root)
         assert run.code == 0, run.err
         assert "\ufffd" not in run.out and "\x1b" not in run.out and "\x85" not in run.out
-    document = json.loads(run_cli(["scan", ".", "--format", "json"], repo.root).out)
+    document = json.loads(run_main(["scan", ".", "--format", "json"], repo.root).out)
     paths = {f["path"] for f in document["files"]}
     assert paths == {
         "caf\\351.py",
@@ -109,6 +115,7 @@ def test_file_names_that_are_not_plain_text_are_escaped_everywhere(
     assert all(f["vg"] == 2 for f in document["files"])
 
 
+@pytest.mark.security
 def test_json_bytes_are_valid_utf8_and_diff_pairs_escaped_names(repo: GitRepo) -> None:
     name = os.fsdecode(NAMES["latin1"])
     repo.commit("v1", files={name: SOURCE})
@@ -121,7 +128,9 @@ def test_json_bytes_are_valid_utf8_and_diff_pairs_escaped_names(repo: GitRepo) -
     assert [e["files"] for e in document["elements"]] == [["caf\\351.py"]]
 
 
-@pytest.mark.parametrize("encoding", ["ascii", "cp1252", "latin-1"])
+@pytest.mark.parametrize(  # the narrowest in the security suite, every one in the whole
+    "encoding", [pytest.param("ascii", marks=pytest.mark.security), "cp1252", "latin-1"]
+)
 @pytest.mark.parametrize("fmt", ["table", "markdown", "csv", "json"])
 def test_every_format_prints_on_a_narrow_encoding(repo: GitRepo, encoding: str, fmt: str) -> None:
     repo.commit("v1", tag="v1", files={"a.py": SOURCE})

@@ -13,6 +13,8 @@ from archmetrics.coupling import patterns
 from tests.gitrepo import GitRepo
 from tests.untrusted import run_cli
 
+pytestmark = pytest.mark.security
+
 PACK = """
 [pack]
 name = "ours"
@@ -62,7 +64,7 @@ def test_a_backtracking_pattern_is_cut_off_and_reported(repo: GitRepo) -> None:
     assert all(s["endpoint"] is None and "gave up after" in s["note"] for s in sent)
     [served] = [s for s in sites if s["rule"] == "ours/serve"]
     assert served["endpoint"] == "name:work" and served["note"] is None
-    table = run_cli(["scan", ".", "--by", "link", "--no-cache"], repo.root)
+    table = run_cli(["scan", ".", "--by", "link", "--no-cache"], repo.root, {"COLUMNS": "300"})
     assert "gave up after" in table.out
 
 
@@ -102,7 +104,10 @@ def test_a_configured_pack_that_cannot_be_trusted_is_refused(
     )
     (repo.root / "link.toml").symlink_to(tmp_path / "outside.toml")
     os.mkfifo(repo.root / "fifo.toml")
-    for argv in (["scan", "."], ["rules"], ["diff", "--base", "EMPTY"]):
+    # a diff reads its base's configuration: EMPTY has none, so the head's is named
+    # (rules loads the packs as scan does)
+    diff = ["diff", "--base", "EMPTY", "--config-from", "head"]
+    for argv in (["scan", "."], diff):
         run = run_cli(argv, repo.root, timeout=60)
         assert run.code == 2, (argv, run.err)
         assert problem in run.one_line_error()

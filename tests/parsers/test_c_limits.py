@@ -203,6 +203,7 @@ def test_long_preprocessor_chains_are_measured() -> None:
     assert len(facts.statements) == 2_000
 
 
+@pytest.mark.security
 def test_a_parse_over_its_time_budget_is_cut_off_and_the_parser_stays_usable() -> None:
     big = "int t[] = {" + ",".join(map(str, range(200_000))) + "};\n"
     facts = read(big, "c", ParseLimits(parse_seconds=1e-6))
@@ -216,6 +217,7 @@ def test_a_parse_over_its_time_budget_is_cut_off_and_the_parser_stays_usable() -
     assert small.warnings == ()
 
 
+@pytest.mark.security
 def test_every_pathological_input_completes_under_an_address_space_limit() -> None:
     """As ``ulimit -v 2000000`` would: the child must finish, measured or refused."""
     script = textwrap.dedent(

@@ -230,7 +230,7 @@ def test_vg_agrees_with_lizard(corpus: list[tuple[str, str, Language]]) -> None:
 
 @pytest.mark.parametrize("which", ["corpus", "macro_corpus"])
 def test_the_functions_lizard_finds_are_found(which: str, request: pytest.FixtureRequest) -> None:
-    """Issue 13: no function lost to a macro or an #if. Found: one of ours ends on the line
+    """No function lost to a macro or an #if. Found: one of ours ends on the line
     where lizard's ends and spans its first line (benchmarks/oracle_c.py, larger corpora)."""
     files: list[tuple[str, str, Language]] = request.getfixturevalue(which)
     total, missed = 0, []

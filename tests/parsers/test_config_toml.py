@@ -5,6 +5,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -82,6 +83,7 @@ def test_a_file_that_is_not_toml_is_not_measured_with_its_line() -> None:
         assert warning.message.startswith("not valid TOML")
 
 
+@pytest.mark.security
 def test_nesting_tomllib_cannot_follow_is_not_measured() -> None:
     facts = parse("deep.toml", "a = " + "[" * 100_000 + "]" * 100_000)
     assert not facts.parsed
@@ -95,6 +97,7 @@ def test_tables_deeper_than_the_key_limit_are_left_out_with_a_warning() -> None:
     assert "deeper than" in facts.warnings[0].message
 
 
+@pytest.mark.security
 def test_more_tables_than_the_limit_is_not_measured() -> None:
     facts = parse("many.toml", "[[t]]\nx = 1\n" * (MAX_TABLES + 1))
     assert not facts.parsed and "tables" in facts.warnings[0].message

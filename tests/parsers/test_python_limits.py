@@ -12,6 +12,7 @@ import json
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
@@ -28,6 +29,7 @@ from archmetrics.parsers import (
 )
 from archmetrics.parsers import limits as limits_module
 from archmetrics.parsers.python_depth import nesting
+from tests.untrusted import run_main
 
 _TABLE = LanguageTable.default(plugins=False)
 NEWER = "type Alias = int\n"  # Python 3.12 syntax: under 3.11 only libcst reads the file
@@ -302,6 +304,7 @@ def test_the_nesting_is_counted_on_the_tokens(source: str, depth: int, brackets:
     assert (found.depth, found.brackets) == (depth, brackets)
 
 
+@pytest.mark.security
 def test_every_pathological_input_completes_under_an_address_space_limit() -> None:
     """As ``ulimit -v 2000000`` would: the child must finish, measured or refused."""
     for source in (
@@ -315,3 +318,20 @@ def test_every_pathological_input_completes_under_an_address_space_limit() -> No
     ):
         found = in_child(source, memory=2_000 * 1024 * 1024)
         assert found["parsed"] or found["warnings"]
+
+
+@pytest.mark.security
+def test_a_flat_file_too_large_for_the_worker_says_memory_ran_out(tmp_path: Path) -> None:
+    """150,000 one-line statements (2.5 million in the report that found it) nest one level
+    deep: the interpreter's parser runs out of the worker's memory (80 MiB here), and the
+    warning says so, not "nested 1 levels deep"."""
+    (tmp_path / "flat.py").write_text("x = 1\n" * 150_000)
+    config = "[tool.archmetrics.limits]\nworker-memory-mb = 80\n"
+    (tmp_path / "pyproject.toml").write_text(config)
+    run = run_main(["scan", "flat.py", "--format", "json", "--no-cache"], tmp_path)
+    assert run.code == 0, run.err
+    (facts,) = json.loads(run.out)["files"]
+    message = facts["warnings"][0]["message"]
+    assert not facts["parsed"] and "levels deep" not in message
+    assert message.startswith("Python source of 150,000 lines and 900,000 characters: the")
+    assert "ran out of memory (MemoryError)" in message and "worker-memory-mb" in message

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from archmetrics.app.diff import DiffRequest
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.series import SeriesRequest, run_compare
 from archmetrics.config import Settings
 from archmetrics.reports.model import CompareReport

@@ -170,6 +170,7 @@ def _tampered(edit: str) -> bytes:
 
 
 @pytest.mark.parametrize("edit", ["statement", "call", "binding", "function"])
+@pytest.mark.security
 def test_codec_rejects_tampered_records(edit: str) -> None:
     assert _tampered(edit) != codec.encode(SAMPLE)
     with pytest.raises(codec.CodecError):
@@ -243,6 +244,7 @@ def _tree(folder: Path) -> dict[str, bytes]:
     ],
     ids=["text", "empty", "source", "bare-header"],
 )
+@pytest.mark.security
 def test_a_file_that_is_not_a_cache_is_refused_and_left_alone(
     tmp_path: Path, content: bytes
 ) -> None:
@@ -313,6 +315,7 @@ def _damage(path: Path, table_change: str) -> None:
     ],
     ids=["facts-missing", "facts-wrong", "older-layout"],
 )
+@pytest.mark.security
 def test_our_cache_with_bad_tables_is_moved_aside_and_rebuilt(tmp_path: Path, change: str) -> None:
     path = tmp_path / "cache.sqlite3"
     with FactsCache(path) as cache:
@@ -365,6 +368,7 @@ def test_moving_aside_never_overwrites_a_file(tmp_path: Path) -> None:
     assert len(kept) == 5
 
 
+@pytest.mark.security
 def test_a_configured_path_stays_inside_the_cache_directory(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -12,6 +12,8 @@ import pytest
 from tests.gitrepo import _ENV, GitRepo
 from tests.untrusted import checksums, run_cli
 
+pytestmark = pytest.mark.security
+
 V1 = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 V2 = V1 + "\n\ndef g(b):\n    return [x for x in b if x]\n"
 

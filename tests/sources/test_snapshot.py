@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from archmetrics.sources.snapshot import DirectorySnapshot
 
 
@@ -91,6 +93,7 @@ def test_a_plain_folder_ignores_what_git_would_ignore(tmp_path: Path) -> None:
     assert "sub/wanted.py" in ours and "keep.log" in ours and "sub/top.py" not in ours
 
 
+@pytest.mark.security
 def test_a_hostile_gitignore_cannot_backtrack(tmp_path: Path) -> None:
     """Under Python's re, pathspec's regex of this pattern against a 250-character name
     backtracks for hours (five stars on 200 characters took 7 s, six 148 s); RE2 cannot."""
@@ -100,6 +103,7 @@ def test_a_hostile_gitignore_cannot_backtrack(tmp_path: Path) -> None:
     assert {f.path for f in DirectorySnapshot(tmp_path).files()} == {".gitignore", "a" * 250}
 
 
+@pytest.mark.security
 def test_a_gitignore_too_large_or_unreadable_counts_as_absent(tmp_path: Path) -> None:
     (tmp_path / "a.py").write_text("")
     (tmp_path / ".gitignore").write_bytes(b"*.py\n" + b"#" * (1 << 20))

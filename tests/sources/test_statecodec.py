@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from archmetrics.app.diff import DiffRequest, diff_options
+from archmetrics.app.diff_options import DiffRequest, diff_options
 from archmetrics.app.progress import NoProgress
 from archmetrics.app.tree import whole_side
 from archmetrics.changeset.state import TreeState

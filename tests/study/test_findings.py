@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from archmetrics.app.diff import DiffRequest
+from archmetrics.app.diff_options import DiffRequest
 from archmetrics.app.series import SeriesRequest, run_compare
 from archmetrics.config import Settings
 from archmetrics.reports.model import CompareReport, SeriesReport
