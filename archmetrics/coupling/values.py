@@ -23,7 +23,10 @@ from archmetrics.coupling.trace import member
 from archmetrics.facts import Argument, CallSite, FileFacts
 from archmetrics.parsers.c_family_calls import split_top_level
 
-_CALL_TEXT = re.compile(r"^\s*([A-Za-z_][\w:.>\-]*?)\s*(?:<.*>)?\s*\((.*)\)\s*$", re.DOTALL)
+# a call or a brace initializer as written (``std::string("x")``, ``std::string{"x"}``)
+_CALL_TEXT = re.compile(
+    r"^\s*([A-Za-z_][\w:.>\-]*?)\s*(?:<.*>)?\s*(?:\((.*)\)|\{(.*)\})\s*$", re.DOTALL
+)
 
 
 def pick(arguments: Sequence[Argument], place: Place) -> Argument | None:
@@ -135,5 +138,5 @@ class ValueCalls:
         rule = self.rule_of(found.group(1))
         if rule is None or rule.value is None:
             return None
-        parts = split_top_level(found.group(2))
+        parts = split_top_level(found.group(2) if found.group(2) is not None else found.group(3))
         return rule, tuple(Argument(part) for part in parts)

@@ -169,7 +169,7 @@ def _links(changed: list[ElementChange]) -> list[str]:
         return []
     return [
         f"<details><summary>{len(rows)} link changes</summary>\n",
-        table(list(diff_rows.LINK_HEADER), rows, "lllll"),
+        table(list(diff_rows.LINK_HEADER), _coded(rows, 0, 3), "lllll"),  # names as code
         "</details>\n",
     ]
 
