@@ -146,7 +146,7 @@ def test_diff_lists_each_elements_links_added_and_removed(
     markdown = _run(capsys, "diff", "-C", str(repo.root), "--base", "v1", "--head", "v2",
                     "--format", "markdown", "--no-cache")  # fmt: skip
     assert "3 link changes" in markdown
-    assert "| avoid_pkg/avoid_pkg/avoider.py | + | initiates | topic:/cmd_vel | 1 |" in markdown
+    assert "| `avoid_pkg/avoid_pkg/avoider.py` | + | initiates | `topic:/cmd_vel` | 1 |" in markdown
     table = _run(capsys, "diff", "-C", str(repo.root), "--base", "v1", "--head", "v2",
                  "--no-cache")  # fmt: skip
     assert "links added and removed" in table and "topic:/scan" in table
