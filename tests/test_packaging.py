@@ -131,7 +131,8 @@ def test_replicate_runs_from_the_installed_wheel(
         timeout=900,
     )
     assert done.returncode == 0, done.stderr
-    assert "idiomatic: " in done.stdout and " of 11 agree" in done.stdout
+    assert "Agree: as-described " in done.stdout and " of 11" in done.stdout
+    assert "Cheapest integration by stage" in done.stdout
     report = json.loads((tmp_path / "study" / "report.json").read_text())
     assert report["schema"] == "archmetrics.study/2"
     assert set(report["variants"]["idiomatic"]["subjects"]) == {"wdb", "pragmatics", "legacy"}

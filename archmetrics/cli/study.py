@@ -13,7 +13,13 @@ from archmetrics.config import Settings
 from archmetrics.reports.charts import charts_missing
 from archmetrics.reports.formats import OutputFormat
 from archmetrics.study.findings import FINDINGS
-from archmetrics.study.report import StudyReport, VariantResult
+from archmetrics.study.report import (
+    StudyReport,
+    VariantResult,
+    agreements,
+    outcome,
+    verdict_word,
+)
 
 if TYPE_CHECKING:
     from archmetrics.study.causes import Cause
@@ -75,22 +81,40 @@ def _unmeasured(variant: VariantResult) -> int:
 def findings_summary(
     report: StudyReport, causes: Mapping[tuple[str, str], Cause], out: Path
 ) -> str:
-    from rich.markup import escape
+    """What the terminal shows, at most 100 columns wide: each finding with its two verdicts,
+    how many agree, the headline (the cheapest architecture stage by stage) and where the
+    full report is (why each verdict differs, the figures and the charts)."""
+    from archmetrics.study.headline import headline
 
-    from archmetrics.reports.table_report import rows_table, to_text
-    from archmetrics.study.report import FINDINGS_HEADER, agreements, findings_rows
-
-    # the causes name elements in [brackets], which rich would take for markup
-    rows = [[escape(cell) for cell in row] for row in findings_rows(report, causes)]
-    title = "the thesis's findings on both variants of the subjects"
-    table = rows_table(title, FINDINGS_HEADER, rows, 5)
+    names = [v.variant for v in report.variants]
+    lines = ["The thesis's findings (chapter 7) measured on the bundled subjects:", ""]
+    lines.append(f"{'finding':20} {'as described':13} {'idiomatic':13} the thesis says")
+    for finding in FINDINGS:
+        verdicts = [verdict_word(outcome(report, v, finding).verdict.agrees) for v in names]
+        claim = _cut(f"{finding.claim} (p. {finding.pages})", WIDTH - 49)
+        lines.append(f"{finding.id:20} {verdicts[0]:13} {verdicts[1]:13} {claim}")
     said = "; ".join(
-        f"{v.variant}: {agreements(report)[v.variant]} of {len(FINDINGS)} agree"
+        f"{v.variant} {agreements(report)[v.variant]} of {len(FINDINGS)}"
         + (f" ({missing} not measured)" if (missing := _unmeasured(v)) else "")
         for v in report.variants
     )
-    return (
-        to_text(table)
-        + f"Findings: {said}. "
-        + f"Report: {out / 'report.md'}, {out / 'report.json'}, charts in {out / 'charts'}\n"
-    )
+    lines += [f"Agree: {said}.", ""]
+    lines.append("Cheapest integration by stage: the lowest E = Γ'/ΔVg' (statements changed per")
+    lines.append("decision point added) over base + framework, " + " / ".join(names) + ":")
+    for row in headline(report):
+        cells = " / ".join("n/a" if c is None else str(c) for c in row.cheapest)
+        lines.append(f"  {row.subject:11} {row.stage:9} {cells}")
+    lines += [
+        "",
+        f"Full report (why each verdict differs, every figure): {out / 'report.md'}",
+        f"and {out / 'report.json'}; charts in {out / 'charts'}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+WIDTH = 100  # the terminal summary's widest line
+
+
+def _cut(text: str, width: int) -> str:
+    """``text`` in at most ``width`` characters, an ellipsis where it was cut."""
+    return text if len(text) <= width else text[: width - 1].rstrip() + "…"

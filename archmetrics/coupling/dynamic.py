@@ -32,6 +32,7 @@ from archmetrics.coupling.matching import (
     choose_rule,
     constructed,
     matches,
+    member,
     normalize_callee,
     requirement_forms,
     requirement_met,
@@ -50,7 +51,7 @@ from archmetrics.coupling.rules import (
     SiteKind,
 )
 from archmetrics.coupling.scopes import FileScopes
-from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader, member
+from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader
 from archmetrics.facts import Argument, CallSite, FileFacts, Language
 
 __all__ = [

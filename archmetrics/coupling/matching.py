@@ -57,6 +57,16 @@ def _normalized(callee: str) -> tuple[str, str]:
     return name, name.rsplit(".", 1)[-1]
 
 
+def member(text: str) -> str:
+    """A name as a variable or member is compared: blanks dropped, ``this->`` left out
+    (``this->pub_`` and ``pub_`` are one C++ member; ``self.pub`` stays as it is)."""
+    name = text.replace(" ", "")
+    for prefix in ("this->", "this.", "(*this)."):
+        if name.startswith(prefix):
+            return name[len(prefix) :]
+    return name
+
+
 def constructed(call: CallSite) -> tuple[str, tuple[str, ...]]:
     """The callee a rule matches and its template arguments: for ``std::make_shared<T>(...)``
     and ``std::make_unique<T>(...)`` the class ``T`` (with ``T``'s own template arguments),

@@ -17,11 +17,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from archmetrics.coupling.matching import constructed, matches
+from archmetrics.coupling.matching import constructed, matches, member
 from archmetrics.coupling.model import LinkSite
 from archmetrics.coupling.rules import Rule
 from archmetrics.coupling.scopes import owner, receiver_of
-from archmetrics.coupling.trace import member
 from archmetrics.facts import CallSite, FileFacts
 
 

@@ -26,11 +26,12 @@ from archmetrics.coupling.matching import (
     Requirements,
     constructed,
     matches,
+    member,
     normalize_callee,
 )
 from archmetrics.coupling.rosnames import UNKNOWN, NodeName, clean_namespace
 from archmetrics.coupling.rules import Place, ScopeRule
-from archmetrics.coupling.trace import ArgumentReader, member
+from archmetrics.coupling.trace import ArgumentReader
 from archmetrics.coupling.values import pick
 from archmetrics.facts import CallSite, FileFacts
 

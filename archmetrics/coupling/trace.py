@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from archmetrics.coupling.endpoints import Lookup, Value, argument_value, literal, tuple_with_names
+from archmetrics.coupling.matching import member
 from archmetrics.facts import Argument, CallSite, FileFacts, Language, Span
 
 if TYPE_CHECKING:
@@ -283,14 +284,6 @@ class Tracer:
         return values.pop() if values else None
 
 
-def member(text: str) -> str:
-    """A name as a variable or member is compared: blanks dropped, ``this->`` left out
-    (``this->pub_`` and ``pub_`` are one C++ member; ``self.pub`` stays as it is)."""
-    name = text.replace(" ", "")
-    for prefix in ("this->", "this.", "(*this)."):
-        if name.startswith(prefix):
-            return name[len(prefix) :]
-    return name
 
 
 _MAKERS = frozenset({"make_shared", "make_unique"})

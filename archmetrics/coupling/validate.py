@@ -2,12 +2,8 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import NoReturn
 
-from archmetrics.coupling.matching import normalize_callee
 from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
@@ -17,14 +13,15 @@ from archmetrics.coupling.rules import (
     EndpointSpec,
     FunctionHint,
     LinkKind,
-    Place,
     Role,
     Rule,
     RulePack,
     RulePackError,
     SiteKind,
 )
-from archmetrics.globs import BadPattern, compile_glob
+from archmetrics.coupling.validate_where import ID as _ID
+from archmetrics.coupling.validate_where import Where, check_glob, parse_place, rule_header
+from archmetrics.coupling.validate_where import list_of as _list
 
 _PACK_KEYS = frozenset({"name", "description"})
 _RULE_KEYS = frozenset(
@@ -35,63 +32,7 @@ _ENDPOINT_KEYS = frozenset(
     {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file", "value",
      "created_by", "naming", "data_type", "created_only"}
 )  # fmt: skip
-_PLACE_KEYS = frozenset({"template", "arg", "keyword", "value", "callback"})
 _HINT_KEYS = frozenset({"match", "arg", "keyword"})
-_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
-
-
-@dataclass(frozen=True, slots=True)
-class Where:
-    source: str
-    rule: str | None = None
-
-    def fail(self, key: str | None, problem: str) -> NoReturn:
-        raise RulePackError(self.source, self.rule, key, problem)
-
-    def table(self, value: object, key: str, allowed: frozenset[str]) -> Mapping[str, object]:
-        if not isinstance(value, Mapping):
-            self.fail(key, f"must be a table, got {type(value).__name__}")
-        for name in value:
-            if name not in allowed:
-                known = _list(allowed)
-                self.fail(f"{key}.{name}" if key else name, f"unknown key (known: {known})")
-        return value
-
-    def text(self, table: Mapping[str, object], key: str, default: str | None = None) -> str:
-        value = table.get(key, default)
-        if not isinstance(value, str) or (default is None and not value):
-            self.fail(key, "required non-empty string" if value is None else "must be a string")
-        return value
-
-    def texts(self, table: Mapping[str, object], key: str, required: bool) -> tuple[str, ...]:
-        value = table.get(key, [] if not required else None)
-        items = [value] if isinstance(value, str) else value
-        if not isinstance(items, list) or not all(isinstance(i, str) and i for i in items):
-            self.fail(key, "must be a string or a list of non-empty strings")
-        if required and not items:
-            self.fail(key, "must not be empty")
-        return tuple(str(i) for i in items)
-
-    def integer(self, table: Mapping[str, object], key: str) -> int | None:
-        value = table.get(key)
-        if key == "arg" and isinstance(value, list) and value:  # [1, 4]: 1, else 4
-            value = value[0]
-        if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
-            self.fail(key, f"must be an integer, got {value!r}")
-        if isinstance(value, int) and key == "arg" and value < 0:
-            self.fail(key, "argument index must be >= 0")
-        return value
-
-    def choice(self, table: Mapping[str, object], key: str, allowed: frozenset[str],
-               default: str | None = None) -> str:  # fmt: skip
-        value = self.text(table, key, default)
-        if value not in allowed:
-            self.fail(key, f"{value!r} is not one of {_list(allowed)}")
-        return value
-
-
-def _list(values: frozenset[str]) -> str:
-    return ", ".join(sorted(values))
 
 
 def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
@@ -119,20 +60,6 @@ def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
         seen.add(ident)
     description = top.text(pack, "description", "")
     return RulePack(name, source, description, rules, configuration, "", scopes, values)
-
-
-def rule_header(
-    raw: object, source: str, unnamed: str, keys: frozenset[str]
-) -> tuple[Where, Mapping[str, object], str]:
-    """A rule's table read with these ``keys``, the place errors name (the rule's id, or
-    ``unnamed`` when it has none) and its id, checked."""
-    rule_id = raw.get("id") if isinstance(raw, Mapping) else None
-    where = Where(source, rule_id if isinstance(rule_id, str) else unnamed)
-    table = where.table(raw, "", keys)
-    ident = where.text(table, "id")
-    if not _ID.match(ident):
-        where.fail("id", f"{ident!r} must be letters, digits and _.+-")
-    return where, table, ident
 
 
 def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
@@ -178,18 +105,8 @@ def _examples(where: Where, raw: object, languages: tuple[str, ...]) -> tuple[tu
 def _patterns(where: Where, table: Mapping[str, object]) -> tuple[str, ...]:
     patterns = where.texts(table, "match", required=True)
     for pattern in patterns:
-        _check_glob(where, "match", pattern)
+        check_glob(where, "match", pattern)
     return patterns
-
-
-def _check_glob(where: Where, key: str, pattern: str) -> None:
-    """A ``match`` pattern: a dotted callee name with globs of the one dialect (globs.py)."""
-    if any(c.isspace() for c in pattern) or "(" in pattern or "/" in pattern:
-        where.fail(key, f"{pattern!r}: a pattern is a dotted callee name with * globs")
-    try:
-        compile_glob(normalize_callee(pattern))
-    except BadPattern as error:
-        where.fail(key, str(error))
 
 
 def _parse_endpoint(where: Where, raw: object) -> EndpointSpec:
@@ -223,7 +140,7 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
         where.fail("same_file", "must be true or false")
     created_by = where.texts(table, "created_by", required=False)
     for match in created_by:
-        _check_glob(where, "created_by", match)
+        check_glob(where, "created_by", match)
     naming = table.get("naming")
     if naming is not None and naming not in NAMINGS:
         where.fail("naming", f"{naming!r} is not one of {_list(NAMINGS)}")
@@ -255,28 +172,6 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
     )
 
 
-def parse_place(where: Where, raw: object, key: str) -> Place:
-    """``{ template = 0 }``, ``{ arg = 1, keyword = "name" }`` or ``{ value = "~" }``."""
-    table = where.table(raw, key, _PLACE_KEYS)
-    try:
-        place = Place(
-            template=where.integer(table, "template"),
-            arg=where.integer(table, "arg"),
-            keyword=where.text(table, "keyword", "") or None,
-            value=where.text(table, "value", "") or None,
-            callback=where.integer(table, "callback"),
-        )
-    except RulePackError as error:
-        raise RulePackError(error.source, error.rule, f"{key}.{error.key}", error.problem) from None
-    if place == Place():
-        where.fail(key, "says nowhere: give template, arg, keyword or value")
-    if place.template is not None and place.template < 0:
-        where.fail(f"{key}.template", "template argument index must be >= 0")
-    if place.callback is not None and place.callback < 0:
-        where.fail(f"{key}.callback", "argument index must be >= 0")
-    return place
-
-
 def _parse_hint(where: Where, raw: object) -> FunctionHint:
     table = where.table(raw, "endpoint.same_function", _HINT_KEYS)
     try:
@@ -287,5 +182,5 @@ def _parse_hint(where: Where, raw: object) -> FunctionHint:
         raise RulePackError(error.source, error.rule, key, error.problem) from None
     if arg is None and keyword is None:
         where.fail("endpoint.same_function", "a hint needs arg or keyword")
-    _check_glob(where, "endpoint.same_function.match", match)
+    check_glob(where, "endpoint.same_function.match", match)
     return FunctionHint(match, arg, keyword)

@@ -16,7 +16,7 @@ from archmetrics.coupling.rules import (
     Role,
     RulePackError,
 )
-from archmetrics.coupling.validate import Where, rule_header
+from archmetrics.coupling.validate_where import Where, rule_header
 from archmetrics.facts import ConfigFormat
 
 _KEYS = frozenset(

@@ -5,13 +5,7 @@ rule and the key, as for ``[[rules]]``."""
 from __future__ import annotations
 
 from archmetrics.coupling.rules import KNOWN_LANGUAGES, ScopeRule, ValueRule
-from archmetrics.coupling.validate import (
-    Where,
-    _check_glob,
-    _list,
-    parse_place,
-    rule_header,
-)
+from archmetrics.coupling.validate_where import Where, check_glob, list_of, parse_place, rule_header
 
 _COMMON = frozenset({"id", "language", "match", "requires", "description"})
 _SCOPE_KEYS = _COMMON | {"kind", "name", "namespace"}
@@ -26,10 +20,10 @@ def _head(
     languages = where.texts(table, "language", required=True)
     for language in languages:
         if language not in KNOWN_LANGUAGES:
-            where.fail("language", f"{language!r} is not one of {_list(KNOWN_LANGUAGES)}")
+            where.fail("language", f"{language!r} is not one of {list_of(KNOWN_LANGUAGES)}")
     match = where.texts(table, "match", required=True)
     for pattern in match:
-        _check_glob(where, "match", pattern)
+        check_glob(where, "match", pattern)
     requires = where.texts(table, "requires", required=False)
     return where, dict(table), ident, languages, match, requires
 

@@ -17,9 +17,8 @@ import re
 from collections.abc import Iterable, Sequence
 from functools import lru_cache
 
-from archmetrics.coupling.matching import matches
+from archmetrics.coupling.matching import matches, member
 from archmetrics.coupling.rules import Place, ValueRule
-from archmetrics.coupling.trace import member
 from archmetrics.facts import Argument, CallSite, FileFacts
 from archmetrics.parsers.c_family_calls import split_top_level
 

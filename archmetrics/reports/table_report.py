@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import shutil
+import textwrap
 from collections.abc import Sequence
 from typing import Literal
 
@@ -114,6 +115,11 @@ def rows_table(
 _NAME_WIDTH = 24  # characters of a row's name shown on one line before it wraps
 
 
+def legend_lines(legend: str) -> str:
+    """``legend: ...`` wrapped to the terminal's width (its lines joined by line breaks)."""
+    return textwrap.fill(f"legend: {legend}", terminal_width(), break_on_hyphens=False)
+
+
 def terminal_width() -> int:
     """The terminal's columns (at least 60), or 160 when there is none."""
     return max(60, shutil.get_terminal_size((160, 24)).columns)
@@ -137,7 +143,7 @@ def render_scan(report: ScanReport, grouping: str, color: bool = False) -> str:
     extra += [f"excluded {x.path}: {x.reason}" for x in report.excluded]
     extra += [f"note: {note}" for note in report.notes]
     legend = SCAN_LEGEND + (" " + ELEMENT_LEGEND if grouping == "element" else "")
-    extra += [f"legend: {legend}", *gate_lines(report)]
+    extra += [legend_lines(legend), *gate_lines(report)]
     return to_text(table, color=color) + "\n".join(extra) + ("\n" if extra else "")
 
 
@@ -186,7 +192,7 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
         tables.append(rows_table("links added and removed", diff_rows.LINK_HEADER, linked, 1))
     unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
-    lines.append(f"legend: {DIFF_LEGEND}")
+    lines.append(legend_lines(DIFF_LEGEND))
     lines += [f"note {n}" for n in diff_rows.notes(report)]
     lines += [f"excluded {x.path}: {x.reason}" for x in report.change.excluded]
     lines += [f"warning {w}" for w in shown_warnings(report.warnings)]

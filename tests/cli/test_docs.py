@@ -32,4 +32,4 @@ def test_a_page_prints_whole_and_by_path(capsys: pytest.CaptureFixture[str]) -> 
 def test_an_unknown_page_is_one_line_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["docs", "../README"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "no page '../README' (pages: api, ci," in err
+    assert err.count("\n") == 1 and "no page '../README' (pages: api, architecture, ci," in err

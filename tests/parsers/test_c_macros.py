@@ -1,8 +1,8 @@
 """Golden cases for C and C++ shaped by the preprocessor (docs/metrics.md, "Macros").
 
 Each class of macro and #if damage is here in C and in C++ where both apply: the functions,
-their v_g and their lines are what lizard reports for the same text, and no warning claims a
-loss where nothing was lost.
+their v_g and their lines are what lizard reports for the same text, and no warning claims a loss
+where nothing was lost.
 """
 
 from __future__ import annotations

@@ -12,11 +12,14 @@ from typing import Any
 import pytest
 from jsonschema import Draft202012Validator
 
-from archmetrics.app.replicate import settings_for, subjects_root
+from archmetrics.app.replicate import ReplicateRequest, run_replicate, settings_for, subjects_root
 from archmetrics.cli import main
+from archmetrics.cli.study import findings_summary
 from archmetrics.study.causes import load_causes
-from archmetrics.study.findings import FINDINGS
-from archmetrics.study.manifest import ManifestError, find_manifests, load_manifest
+from archmetrics.study.findings import FINDINGS, summary
+from archmetrics.study.headline import NAMES
+from archmetrics.study.manifest import VARIANTS, ManifestError, find_manifests, load_manifest
+from archmetrics.study.report import StudyReport, outcome, verdict_word
 
 
 @pytest.fixture(scope="module")
@@ -194,7 +197,7 @@ HEAD = 'subject = "s"\napproach = "a"\nvariant = "idiomatic"\ntitle = "t"\n'
         (f'{HEAD}stages = "x"\n', "stages: expected a list"),
         (f"{HEAD}stages = []\n[exclude]\ngenerated = 1\n", "exclude.generated: expected true"),
         ('subject = "s"\napproach = "a"\ntitle = "t"\nstages = []\n', "'variant' must be a"),
-        (f'{HEAD.replace("idiomatic", "literal")}stages = []\n', "variant must be one of"),
+        (f"{HEAD.replace('idiomatic', 'literal')}stages = []\n", "variant must be one of"),
         (f'{HEAD.replace("idiomatic", "as-described")}stages = ["s"]\n', "stage.s: an as-desc"),
         (f'{HEAD}stages = ["s"]\n[stage.s]\nfollows = "x"\npage = "9"\n', "stage.s: 'page'"),
         (f'{HEAD}stages = ["s"]\n[stage.s]\npage = 9\n', "stage.s: 'follows' must be"),
@@ -239,15 +242,38 @@ def test_the_appendix_lists_every_element_and_sums_to_the_locations(
     assert sum(int(row[11]) - int(row[10]) for row in framework) == expected["delta_vg"]
 
 
-def test_the_printed_table_keeps_the_elements_a_cause_names(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.fixture(scope="module")
+def wdb() -> StudyReport:
+    """The study of the World Database subject alone, as a report value."""
+    return run_replicate(ReplicateRequest(subjects_root(), ("wdb",)))
+
+
+def test_the_terminal_summary_fits_100_columns_and_ends_with_the_headline(
+    wdb: StudyReport,
 ) -> None:
-    """Causes name elements in [brackets]; the terminal table prints them (not as markup)."""
-    out = tmp_path / "out"
-    assert main(["replicate", "--subject", "legacy", "--out", str(out), "--no-charts",
-                 "--quiet"]) == 0  # fmt: skip
-    printed = capsys.readouterr().out
-    assert "idiomatic disagrees" in printed and "[p2d_service/*.py," in printed
+    """Each finding with its two verdicts, the cheapest architecture stage by stage, and
+    where the full report is, in lines of at most 100 characters."""
+    text = findings_summary(wdb, load_causes(), Path("out"))
+    lines = text.splitlines()
+    assert max(len(line) for line in lines) <= 100, max(lines, key=len)
+    for finding in FINDINGS:
+        [line] = [x for x in lines if x.startswith(f"{finding.id} ")]
+        words = [verdict_word(outcome(wdb, v, finding).verdict.agrees) for v in VARIANTS]
+        assert [line[21:34].strip(), line[35:48].strip()] == words, line
+    assert lines[-2:] == [
+        "Full report (why each verdict differs, every figure): out/report.md",
+        "and out/report.json; charts in out/charts",
+    ]
+    rows = [x.split(None, 2) for x in lines if x.startswith("  wdb ")]
+    assert [r[1] for r in rows] == ["baseline", "first", "second"]
+    for _, stage, cells in rows:
+        for cell, result in zip(cells.split(" / "), wdb.variants, strict=True):
+            costs = {a: summary(s, stage).cost for a, s in result.subjects[0].compare.series}
+            named, cost = cell.rsplit(" ", 1)
+            lowest = min(round(c, 2) for c in costs.values())
+            assert float(cost) == lowest, (stage, cell, costs)
+            tied = sorted(NAMES[a] for a, c in costs.items() if round(c, 2) == lowest)
+            assert named.split("=") == tied, (stage, cell, costs)
 
 
 def test_the_figures_docs_ci_quotes_are_the_study_s(report: Any) -> None:
