@@ -74,8 +74,8 @@ def computation_graph(report: CouplingReport) -> ComputationGraph:
                     flows[(element, key, "initiate")] += 1
                 else:
                     flows[(key, element, "receive")] += 1
-                if site.node:
-                    names.setdefault(element, set()).add(site.node)
+                if site.node and site.kind is not LinkKind.CONFIG:  # a launch entry's
+                    names.setdefault(element, set()).add(site.node)  # node: the one it starts
     loaded = {key for _, key, role in flows if role == "initiate"}
     flows = Counter({f: n for f, n in flows.items() if _shown(f, loaded)})
     linked = {element for element, _ in _ends(flows)}
