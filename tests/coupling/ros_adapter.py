@@ -62,7 +62,8 @@ _RULE_KINDS: dict[str, str] = {
                     "service-server"),
     **dict.fromkeys(("client", "client-function", "py-client", "service-client",
                      "py-service-proxy"), "service-client"),
-    "camera-info-manager": "service-server",
+    "camera-info-manager": "service-server", "lifecycle-client": "service-client",
+    "lifecycle-call": "call",
     **dict.fromkeys(("call", "py-call", "service-call"), "call"),
     **dict.fromkeys(("action-server", "action-server-member", "py-action-server"),
                     "action-server"),
@@ -123,6 +124,9 @@ def ros_endpoint(site: Mapping[str, object]) -> tuple[str, str | None, str | Non
         endpoint = f"plugin:{site['endpoint_text']}"  # its lookup name, as the oracle names it
     elif KIND_CATEGORY.get(kind) == "plugin" and site.get("endpoint_name"):
         endpoint = site["endpoint_name"]  # a pluginlib lookup name, as the oracle names it
+    if rule_id in ("lifecycle-client", "lifecycle-call") and endpoint:  # the node's services
+        method = str(site.get("callee", "")).rpartition(">")[2].rpartition(".")[2]
+        endpoint = f"{endpoint}/{method if rule_id == 'lifecycle-call' else 'change_state'}"
     if kind == "param-remote" and endpoint:  # the node's parameter service the call names
         endpoint = f"{endpoint}/{str(site.get('callee', '')).rpartition('>')[2].rpartition('.')[2]}"
     named = endpoint and site.get("status") != "unresolved"
