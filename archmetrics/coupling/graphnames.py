@@ -34,6 +34,7 @@ from archmetrics.coupling.values import pick
 from archmetrics.facts import Binding, CallSite, Dependency, Statement
 from archmetrics.parsers.c_family_calls import template_arguments, without_template_arguments
 
+_DECLARED = re.compile(r"(?:const\s+)?([A-Za-z_][\w:]*)\s+([A-Za-z_]\w*)\s*;")
 _SHARED = re.compile(r"(?:boost|std)::shared_ptr<(.+)>")
 _CALLBACK_SUFFIX = re.compile(r"(?:::ConstPtr|::Ptr|ConstPtr|::Request|::Response)$")
 _TYPE_NAME = re.compile(r"[A-Za-z_]\w*(?:::[A-Za-z_]\w*)*(?:<.*>)?")
@@ -78,15 +79,18 @@ class TypeAliases:
         self._statements = statements
         self._found: dict[str, dict[str | None, str]] | None = None
 
-    def parameter_type(self, callback: str) -> str | None:
+    def parameter_type(self, callback: str, function: str | None = None) -> str | None:
         """The type of the first parameter of the function ``callback`` names (``onScan``,
         ``&Node::onScan``) as written, without its reference, ``ConstPtr`` or ``Request``;
-        None when the file defines no such function."""
+        else, for a plain name, the type a declaration in ``function`` gives it
+        (``nav_msgs::GetMap map;``); None when the file says neither."""
         name = callback.replace(" ", "").lstrip("&").rpartition("::")[2]
         if not name.isidentifier():
             return None
         heads = [s.text for s in self._statements if s.kind == "function" and s.function
                  and (s.function == name or s.function.endswith("::" + name))]  # fmt: skip
+        if not heads and name == callback.strip():
+            return self._declared(name, function)
         if len(heads) != 1 or "(" not in heads[0]:
             return None
         first = heads[0].partition("(")[2].rpartition(")")[0].split(",")[0].split("=")[0]
@@ -98,6 +102,17 @@ class TypeAliases:
         inner = _SHARED.fullmatch(written)
         written = inner.group(1) if inner else written
         return _CALLBACK_SUFFIX.sub("", written) or None
+
+    def _declared(self, name: str, function: str | None) -> str | None:
+        """The type ``T`` of the one declaration ``T name;`` in ``function``."""
+        found = {
+            declared.group(1)
+            for s in self._statements
+            if s.kind == "declaration" and s.function == function
+            and (declared := _DECLARED.fullmatch(re.sub(r"\s*::\s*", "::", s.text)))
+            and declared.group(2) == name
+        }  # fmt: skip
+        return found.pop() if len(found) == 1 else None
 
     def get(self, name: str, function: str | None) -> str | None:
         """The type ``name`` stands for in ``function``: its alias there, else one given
@@ -167,7 +182,7 @@ def _data_type(
     if not written and place.callback is not None and aliases is not None:
         positional = [a for a in call.arguments if a.keyword is None]
         if place.callback < len(positional):
-            written = aliases.parameter_type(positional[place.callback].text)
+            written = aliases.parameter_type(positional[place.callback].text, call.function)
     if not written:
         return ""
     written = written.replace(" ", "")

@@ -63,7 +63,7 @@ _RULE_KINDS: dict[str, str] = {
     **dict.fromkeys(("client", "client-function", "py-client", "service-client",
                      "py-service-proxy"), "service-client"),
     "camera-info-manager": "service-server", "lifecycle-client": "service-client",
-    "lifecycle-call": "call",
+    "lifecycle-call": "call", "dynamic-reconfigure": "dynamic-reconfigure",
     **dict.fromkeys(("call", "py-call", "service-call"), "call"),
     **dict.fromkeys(("action-server", "action-server-member", "py-action-server"),
                     "action-server"),
