@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from archmetrics.coupling.endpoints import normalize
-from archmetrics.coupling.matching import constructed
+from archmetrics.coupling.matching import constructed, member
 from archmetrics.coupling.model import Endpoint, LinkSite
 from archmetrics.coupling.rosnames import (
     UNKNOWN,
@@ -35,6 +35,7 @@ from archmetrics.facts import Binding, CallSite, Dependency, Statement
 from archmetrics.parsers.c_family_calls import template_arguments, without_template_arguments
 
 _DECLARED = re.compile(r"(?:const\s+)?([A-Za-z_][\w:]*)\s+([A-Za-z_]\w*)\s*;")
+_TEMPLATED = re.compile(r"(?:const\s*)?([A-Za-z_][\w:]*<.*>)\s*([A-Za-z_]\w*)\s*;")
 _SHARED = re.compile(r"(?:boost|std)::shared_ptr<(.+)>")
 _CALLBACK_SUFFIX = re.compile(r"(?:::ConstPtr|::Ptr|ConstPtr|::Request|::Response)$")
 _TYPE_NAME = re.compile(r"[A-Za-z_]\w*(?:::[A-Za-z_]\w*)*(?:<.*>)?")
@@ -114,6 +115,18 @@ class TypeAliases:
         }  # fmt: skip
         return found.pop() if len(found) == 1 else None
 
+    def receiver_templates(self, receiver: str, function: str | None) -> tuple[str, ...]:
+        """The template arguments of the type the object ``receiver`` is declared with, in
+        ``function`` or as a member (``message_filters::Subscriber<T> sub_;``); () when none."""
+        found = {
+            declared.group(1)
+            for s in self._statements
+            if s.kind in ("field", "declaration") and s.function in (function, None)
+            and (declared := _TEMPLATED.fullmatch(re.sub(r"\s*([:<>,])\s*", r"\1", s.text)))
+            and declared.group(2) == receiver
+        }  # fmt: skip
+        return template_arguments(found.pop()) if len(found) == 1 else ()
+
     def get(self, name: str, function: str | None) -> str | None:
         """The type ``name`` stands for in ``function``: its alias there, else one given
         outside any function; None when there is none."""
@@ -175,6 +188,8 @@ def _data_type(
     written: str | None = None
     if place.template is not None:
         _, templates = constructed(call)
+        if not templates and call.receiver and aliases is not None:  # sub_.subscribe(...)
+            templates = aliases.receiver_templates(member(call.receiver), call.function)
         written = templates[place.template] if place.template < len(templates) else None
     elif place.arg is not None or place.keyword is not None:
         argument = pick(call.arguments, place)
