@@ -35,6 +35,7 @@ class LocationSettings:
 @dataclass(frozen=True, slots=True)
 class CouplingSettings:
     per_file: bool = False
+    group: str = "component"  # component | file | package | node (docs/metrics.md, Elements)
     include_dirs: tuple[str, ...] = ()
     ignore_includes: tuple[str, ...] = ("stdio.h", "stdlib.h")
     ignore_imports: tuple[str, ...] = ("__future__",)
@@ -186,15 +187,27 @@ def _locations(table: Mapping[str, Any], where: str) -> LocationSettings:
 
 
 def _coupling(table: Mapping[str, Any], where: str) -> CouplingSettings:
-    names = {"per-file", "include-dirs", "ignore-includes", "ignore-imports", "rule-packs"}
+    names = {"per-file", "include-dirs", "ignore-includes", "ignore-imports", "rule-packs", "group"}
     _check_keys(table, names, where)
     values: dict[str, Any] = {}
     for key, value in table.items():
         here = f"{where}.{key}"
+        if key == "group":
+            values[key] = _choice(value, here, GROUPINGS)
+            continue
         values[key.replace("-", "_")] = (
             _bool(value, here) if key == "per-file" else _strings(value, here)
         )
     return CouplingSettings(**values)
+
+
+GROUPINGS = ("component", "file", "package", "node")  # coupling/elements.py
+
+
+def _choice(value: Any, where: str, allowed: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value not in allowed:
+        raise ConfigError(f"{where}: expected one of {', '.join(allowed)}")
+    return value
 
 
 def _int(value: Any, where: str) -> int:

@@ -174,7 +174,15 @@ class CallSite(NamedTuple):
 
     ``callee`` is the called expression's text (``bus.request``, ``zmq_connect``,
     ``dynamic_cast``); ``name`` its last component (``request``); ``receiver`` the text
-    before the last ``.``/``->``/``::`` when there is one.
+    before the last ``.``/``->``/``::`` when there is one. In C++ a constructor called
+    without a call expression is a call site too, its callee the class (template arguments
+    in ``templates``): ``new T(a)``, a declaration ``T x(a);`` or ``T x{a};`` (``target``
+    ``x``), an initializer ``Base(a)`` or ``member_(a)`` of a constructor (a member's callee
+    is its declared type when the file declares it, else its name); and so is a macro
+    called alone on its line between declarations (``PLUGINLIB_EXPORT_CLASS(A, B)``).
+    ``target`` is the name the call's value is assigned to (``x = f()``, ``T x = f();``, a
+    member initializer ``x_(f())``; also when only accessors follow the call, as in
+    ``x = f().value`` or ``x = f().as_string()``).
     """
 
     callee: str
@@ -183,6 +191,12 @@ class CallSite(NamedTuple):
     span: Span
     arguments: tuple[Argument, ...] = ()
     function: str | None = None  # qualified name of the enclosing function, if any
+    # C++: the template arguments of the callee's last part as written, normalized
+    # (``create_publisher<geometry_msgs::msg::Twist>`` -> ``("geometry_msgs::msg::Twist",)``)
+    templates: tuple[str, ...] = ()
+    # what the call's value is assigned to or initializes, as written (``pub_``,
+    # ``this->pub_``, ``self.pub``, a declared variable); None when it is not
+    target: str | None = None
 
 
 class ConfigFormat(StrEnum):
@@ -190,6 +204,9 @@ class ConfigFormat(StrEnum):
     files are read as configuration is the rule packs' word (docs/metrics.md)."""
 
     TOML = "toml"
+    XML = "xml"
+    YAML = "yaml"
+    ROSIDL = "rosidl"  # a ROS interface definition (.msg, .srv, .action): listed, λ = 0
 
 
 class ConfigTable(NamedTuple):
@@ -206,6 +223,9 @@ class ConfigTable(NamedTuple):
     keys: tuple[str, ...]
     line: int
     values: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    # the index, among the file's tables, of the table holding this one (-1: none read); an
+    # XML element's or a YAML mapping's parent, so a launch file's <remap> finds its <node>
+    parent: int = -1
 
     def get(self, key: str) -> tuple[str, ...] | None:
         """The values of ``key``, None when the table does not hold it."""

@@ -39,8 +39,12 @@ def select(
     """The files of ``snapshot`` that have a language and that ``keep`` accepts: source by
     its ending, else configuration in the format ``configuration`` (from the rule packs,
     :func:`archmetrics.app.coupling.configuration_files`) gives for its path."""
+    files = list(snapshot.files())
+    in_tree = getattr(configuration, "in_tree", None)
+    if in_tree is not None:  # rules naming files only inside ROS packages (package.xml)
+        configuration = in_tree([f.path for f in files])
     chosen = []
-    for file in snapshot.files():
+    for file in files:
         language = table.language_of(file.path)
         if language is None and configuration is not None:
             language = configuration(file.path)

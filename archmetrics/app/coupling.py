@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -28,6 +29,7 @@ def coupling_options(settings: Settings) -> CouplingOptions:
         ignore_imports=c.ignore_imports,
         include_dirs=c.include_dirs,
         per_file=c.per_file,
+        group=c.group,
     )
 
 
@@ -84,26 +86,57 @@ def packs_digest(packs: RuleSet) -> str:
     return known[1]
 
 
-def configuration_files(packs: RuleSet) -> Callable[[str], str | None]:
+class ConfigurationFiles:
     """A path's configuration format, by the ``files`` globs of the packs' configuration
     rules (the first rule, in load order, that names the path decides), or None: which files
-    a scan or diff reads as configuration (docs/metrics.md, "Configuration links")."""
-    globs: list[tuple[GitIgnoreSpec, str]] = []
-    for pack in packs.packs:
-        for rule in pack.configuration:
-            for glob in rule.files:
-                try:
-                    globs.append((compile_glob(glob), rule.format))
-                except BadPattern as error:
-                    raise RulePackError(pack.source, rule.id, "files", str(error)) from None
+    a scan or diff reads as configuration (docs/metrics.md, "Configuration links"). A rule
+    with ``within`` (``package.xml``) names files only in a tree holding that file (a ROS
+    workspace; a launch file or plugin description need not sit in a package of its own):
+    :meth:`in_tree` says which folders hold it, from the tree's paths; until then such
+    rules name nothing."""
 
-    def format_of(path: str) -> str | None:
-        if not globs:
+    def __init__(self, packs: RuleSet) -> None:
+        self.globs: list[tuple[GitIgnoreSpec, str, str | None]] = []
+        for pack in packs.packs:
+            for rule in pack.configuration:
+                for glob in rule.files:
+                    try:
+                        self.globs.append((compile_glob(glob), rule.format, rule.within))
+                    except BadPattern as error:
+                        raise RulePackError(pack.source, rule.id, "files", str(error)) from None
+        self.markers = frozenset(w for _, _, w in self.globs if w)
+        self.folders: dict[str, frozenset[str]] = {}
+
+    def in_tree(self, paths: Iterable[str]) -> ConfigurationFiles:
+        """These rules for the tree of ``paths``: the folders holding each marker known."""
+        if not self.markers:
+            return self
+        bound = copy.copy(self)
+        found: dict[str, set[str]] = {marker: set() for marker in self.markers}
+        for path in paths:
+            folder, _, name = path.rpartition("/")
+            if name in found:
+                found[name].add(folder)
+        bound.folders = {marker: frozenset(f) for marker, f in found.items()}
+        return bound
+
+    def __call__(self, path: str) -> str | None:
+        if not self.globs:
             return None
         clean = normalize_path(path)
-        return next((fmt for glob, fmt in globs if glob.match_file(clean)), None)
+        for glob, fmt, within in self.globs:
+            if glob.match_file(clean) and (within is None or self._inside(clean, within)):
+                return fmt
+        return None
 
-    return format_of
+    def _inside(self, path: str, marker: str) -> bool:
+        """Whether the tree of ``path`` holds ``marker`` (in any folder)."""
+        return bool(self.folders.get(marker))
+
+
+def configuration_files(packs: RuleSet) -> ConfigurationFiles:
+    """Which files the packs read as configuration, and in which format (ConfigurationFiles)."""
+    return ConfigurationFiles(packs)
 
 
 def pack_path(root: Path, text: str) -> Path:

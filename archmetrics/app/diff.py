@@ -165,14 +165,16 @@ def compare_sides(
     others are reported from the base side's element rows (changeset/unchanged.py)."""
     differ = diff_measured if cache is None else cached_differ(cache, pre.by_path, post.by_path)
     values = (pre.state.index.values, post.state.index.values)
+    links = (pre.state.index.sites, post.state.index.sites)
     same = pre.state.groups is post.state.groups or pre.state.groups == post.state.groups
     if not same:
         pairs = pair_files(pre.state.rows, post.state.rows, renames)
         paths = {row.path for row in (*pre.state.rows, *post.state.rows)}
-        elements = group_elements(paths, options.coupling.per_file)
+        elements = group_elements(paths, options.coupling.grouping)
         return compute_change(
             _with_facts(pairs, pre, post, options, progress), elements, options.rules,
             values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
+            links=links,
         )  # fmt: skip
     changed = post.changed if post.changed is not None else _differing(pre, post)
     owner = pre.owner
@@ -186,7 +188,7 @@ def compare_sides(
     return compute_change(
         _with_facts(pairs, pre, post, options, progress), touched_elements, options.rules,
         values[0], values[1], dynamic_pre_zero=options.dynamic_pre_zero, diff=differ,
-        unchanged=unchanged,
+        unchanged=unchanged, links=links,
     )  # fmt: skip
 
 

@@ -87,7 +87,7 @@ def measure_base(
     values = coupling_by_element(coupling)
     change = compute_change(
         [FilePair(f, f) for f in files],
-        group_elements({f.path for f in files}, coupling_options.per_file),
+        group_elements({f.path for f in files}, coupling_options.grouping),
         rules,
         values,
         values,

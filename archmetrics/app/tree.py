@@ -30,6 +30,7 @@ from archmetrics.changeset.rows import FileRow
 from archmetrics.changeset.state import TreeState, owners, patched_state, tree_state
 from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index, patch_index
 from archmetrics.coupling.measure import link_tree
+from archmetrics.coupling.rostree import configures
 from archmetrics.facts import FileFacts
 from archmetrics.parsers import LanguageTable
 from archmetrics.sources import Snapshot, SourceFile
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
     from archmetrics.app.diff_options import DiffOptions
 
 STATE_RECORD = "tree-state/1"
+_CONFIGURATION = frozenset({"xml", "yaml"})  # a tree holding these is ROS: patched whole
 PATCH_LIMIT = 0.25  # a delta touching more than this share of a tree's files: built whole
 
 
@@ -182,7 +184,7 @@ def whole_side(
     rows = tuple(FileRow.of(f, blobs[f.path]) for f in facts)
     progress.phase(f"coupling {snapshot.label}")
     index = _couple(facts, rows, options, cache)
-    state = tree_state(rows, index, options.rules, options.coupling.per_file)
+    state = tree_state(rows, index, options.rules, options.coupling.grouping)
     return Side(snapshot, state, cache, {f.path: f for f in facts})
 
 
@@ -221,6 +223,11 @@ def patched_side(
         return None
     table = LanguageTable.default(dict(options.languages))
     configuration = configuration_files(options.packs)
+    if configuration.markers:  # which folders are ROS packages: a new or gone one, built whole
+        touched = {f.path for f in delta.changed} | set(delta.removed)
+        if any(path.rpartition("/")[2] in configuration.markers for path in touched):
+            return None
+        configuration = configuration.in_tree(row.path for row in rows_before)
     selected = [
         Selected(f, language)
         for f in delta.changed
@@ -245,7 +252,7 @@ def patched_side(
         index = _patched_index(origin, side, changed, options, cache)
     except MissingFacts:  # the cache lost a file's facts since the state was kept
         return None
-    rules, per_file = options.rules, options.coupling.per_file
+    rules, per_file = options.rules, options.coupling.grouping
     side.state = patched_state(origin.state, rows, index, changed, rules, per_file, origin.owner)
     return side
 
@@ -286,6 +293,13 @@ def _patched_index(
         return row is not None and row.parsed and exclusion(row, rules) is None
 
     redone: dict[str, FileFacts] = {}
+    if (
+        origin.state.index.whole
+        or any(row.language in _CONFIGURATION for row in origin.state.rows)
+        or any(configures(side.facts(path)) for path in changed if path in side.by_path)
+    ):  # launch, parameter or plugin files rename sites or receive them (rosgraph.py)
+        facts = [side.facts(row.path) for row in measured_files(side.state.rows, rules)]
+        return _couple(facts, side.state.rows, options, cache)
     for path in sorted(changed):
         before, after = origin.by_path.get(path), side.by_path.get(path)
         if measured(before) != measured(after) or (

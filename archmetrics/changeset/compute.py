@@ -31,6 +31,7 @@ from archmetrics.changeset.elements import (
     CouplingValues,
     Differ,
     ElementLike,
+    Links,
     Side,
     assign,
     element_change,
@@ -97,12 +98,15 @@ def compute_change(
     dynamic_pre_zero: bool = False,
     diff: Differ = diff_measured,
     unchanged: Unchanged | None = None,
+    links: tuple[Links | None, Links | None] = (None, None),
 ) -> ChangeReport:
     """Chapter 6 metrics of one comparison: per location, total, per element, exclusions.
 
     ``unchanged``: elements none of whose files changed, reported from their rows; their
     pairs are then left out of ``pairs`` (a diff of two trees that share most files pairs
-    only the files of the elements that hold a changed one)."""
+    only the files of the elements that hold a changed one). ``links``: each side's link
+    sites by file (the coupling index's), from which each element's link changes are
+    listed."""
     kept, excluded = measured_pairs(pairs, rules)
     if elements is None:
         paths = {f.path for p in kept for f in (p.pre, p.post) if f is not None}
@@ -111,7 +115,10 @@ def compute_change(
     rows = unchanged.elements if unchanged else {}
     if rows.keys() & groups.keys():
         raise ValueError("an element is both unchanged and paired")
-    sides = (Side("pre", coupling_pre, dynamic_pre_zero), Side("post", coupling_post))
+    sides = (
+        Side("pre", coupling_pre, dynamic_pre_zero, links[0]),
+        Side("post", coupling_post, links=links[1]),
+    )
     changes: list[ElementChange] = []
     notes: list[tuple[Location, str]] = []
     plain: list[str] = []

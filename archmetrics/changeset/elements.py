@@ -16,6 +16,7 @@ from archmetrics.changeset.locations import Location, LocationRules
 from archmetrics.changeset.model import (
     ElementChange,
     FilePair,
+    LinkChange,
     MeasuredFile,
     Metrics,
     Status,
@@ -25,6 +26,7 @@ from archmetrics.changeset.statement_diff import FileChange
 from archmetrics.facts import FileFacts
 
 CouplingValues = tuple[int, int, int, int]
+Links = Mapping[str, tuple[tuple[str, str | None], ...]]  # a tree's link sites by file
 
 # How a file pair's change is found: diff_measured, or a function that gives what it would
 # give (the application's, which keeps changes in the cache by the files' blobs)
@@ -48,6 +50,33 @@ class Side:
     label: str  # "pre" or "post"
     values: Mapping[str, CouplingValues] | None  # s_a, s_e, d_a, d_e (a Coupling or a tuple)
     dynamic_zero: bool = False  # the thesis convention (p. 100): d_a = d_e = 0 before
+    links: Links | None = None  # each file's link sites as the coupling index keeps them
+
+
+def link_changes(
+    pre_files: Iterable[str], post_files: Iterable[str], sides: tuple[Side, Side]
+) -> tuple[tuple[LinkChange, ...], tuple[LinkChange, ...]]:
+    """The link sites (role and endpoint) ``post_files`` have that ``pre_files`` had not,
+    and the reverse, each with how many (a publisher added on a topic the element already
+    published on is one more); none when a side has no link records."""
+    before, after = sides[0].links, sides[1].links
+    if before is None or after is None:
+        return (), ()
+    old = Counter(s for path in pre_files for s in before.get(path, ()) if s[0] != _ALSO)
+    new = Counter(s for path in post_files for s in after.get(path, ()) if s[0] != _ALSO)
+    return _listed(new - old), _listed(old - new)
+
+
+_ALSO = "also"  # a key a receiving site also receives: no site (coupling/index.py)
+
+
+def _listed(changes: Counter[tuple[str, str | None]]) -> tuple[LinkChange, ...]:
+    return tuple((role, key, count) for (role, key), count in sorted(changes.items(), key=_by_key))
+
+
+def _by_key(item: tuple[tuple[str, str | None], int]) -> tuple[str, str]:
+    (role, key), _ = item
+    return (key or "", role)
 
 
 def element_index(elements: Iterable[ElementLike]) -> dict[str, str]:
@@ -163,6 +192,9 @@ def element_change(
     added = sum(c.added for c in file_changes)
     removed = sum(c.removed for c in file_changes)
     modified = sum(c.modified for c in file_changes)
+    links = link_changes(
+        [p.pre.path for p in pairs if p.pre], [p.post.path for p in pairs if p.post], sides
+    )
     return ElementChange(
         element=element,
         location=file_location(element, pairs, rules, notes),
@@ -175,4 +207,6 @@ def element_change(
         removed=removed,
         modified=modified,
         file_changes=file_changes,
+        links_added=links[0],
+        links_removed=links[1],
     )

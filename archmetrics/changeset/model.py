@@ -126,11 +126,15 @@ class ElementChange(NamedTuple):
     removed: int
     modified: int
     file_changes: tuple[FileChange, ...] = ()  # the detail behind added/removed/modified
+    # link sites its files have after and not before, and before and not after: (role,
+    # endpoint key or None when unknown, how many)
+    links_added: tuple[LinkChange, ...] = ()
+    links_removed: tuple[LinkChange, ...] = ()
 
     def to_dict(self) -> dict[str, JsonValue]:
         # a diff writes one per element of the tree (28,000 in a large one): the fields by
         # unpacking, the enums' values as stored (``_value_``: ``.value`` is a property)
-        element, location, files, status, pre, post, added, removed, modified, _ = self
+        element, location, files, status, pre, post, added, removed, modified = self[:9]
         return {
             "element": element,
             "location": location._value_,
@@ -141,7 +145,17 @@ class ElementChange(NamedTuple):
             "added": added,
             "removed": removed,
             "modified": modified,
+            "links_added": link_records(self.links_added),
+            "links_removed": link_records(self.links_removed),
         }
+
+
+LinkChange = tuple[str, str | None, int]
+
+
+def link_records(changes: tuple[LinkChange, ...]) -> list[JsonValue]:
+    """Link changes as JSON records: role, endpoint (null: not known statically), count."""
+    return [{"role": role, "endpoint": key, "count": count} for role, key, count in changes]
 
 
 @dataclass(frozen=True, slots=True)

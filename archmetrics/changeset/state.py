@@ -30,7 +30,7 @@ class TreeState:
     excluded: tuple[ExcludedFile, ...]
 
 
-def grouped(rows: Sequence[FileRow], per_file: bool) -> tuple[Element, ...]:
+def grouped(rows: Sequence[FileRow], per_file: bool | str) -> tuple[Element, ...]:
     """The elements of ``rows``' paths, as a diff groups them (by their endings' languages)."""
     return group_elements([row.path for row in rows], per_file)
 
@@ -39,7 +39,7 @@ def tree_state(
     rows: tuple[FileRow, ...],
     index: CouplingIndex,
     rules: LocationRules,
-    per_file: bool,
+    per_file: bool | str,
     groups: tuple[Element, ...] | None = None,
 ) -> TreeState:
     """The state of a tree with these rows and coupling index, under ``rules``; ``groups``
@@ -60,7 +60,7 @@ def patched_state(
     index: CouplingIndex,
     changed: frozenset[str],
     rules: LocationRules,
-    per_file: bool,
+    per_file: bool | str,
     owner: Mapping[str, str] | None = None,
 ) -> TreeState:
     """The state of ``origin``'s tree with the files at ``changed`` paths changed, now

@@ -20,6 +20,7 @@ from archmetrics.changeset.elements import (
     assign,
     element_index,
     file_location,
+    link_changes,
     side_metrics,
 )
 from archmetrics.changeset.files import measured_pairs
@@ -90,7 +91,11 @@ def unchanged_change(
     post = _metrics(name, row, sides[1], notes)
     if row.notes:
         notes.extend(row.notes)
-    return _new(ElementChange, (name, row[1], row[0], _UNCHANGED, pre, post, 0, 0, 0, ()))
+    added, removed = link_changes(row[0], row[0], sides)
+    return _new(
+        ElementChange,
+        (name, row[1], row[0], _UNCHANGED, pre, post, 0, 0, 0, (), added, removed),
+    )
 
 
 _new = tuple.__new__
@@ -172,6 +177,8 @@ class PlainElements:
                     "added": 0,
                     "removed": 0,
                     "modified": 0,
+                    "links_added": [],  # its values are the same on both sides
+                    "links_removed": [],
                 }
             )
         return made

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -183,6 +184,10 @@ def _with_excludes(
         settings = load(path, tuple(getattr(args, "exclude", None) or ()), raised)
     except BadPattern as error:
         raise UsageError(f"--exclude: {error}") from None
+    group = getattr(args, "group", None)
+    if group is not None:  # --group over [tool.archmetrics.coupling] group
+        coupling = dataclasses.replace(settings.coupling, group=group, per_file=group == "file")
+        settings = dataclasses.replace(settings, coupling=coupling)
     for notice in settings.notices:
         warn(notice)
     if args is not None:

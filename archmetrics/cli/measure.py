@@ -143,6 +143,7 @@ def rules_command(args: argparse.Namespace) -> int:
 
 
 def graph_command(args: argparse.Namespace) -> int:
+    from archmetrics.coupling.computation import computation_graph
     from archmetrics.reports.graph import render
 
     paths: tuple[Path, ...] = tuple(args.paths)
@@ -151,7 +152,12 @@ def graph_command(args: argparse.Namespace) -> int:
     with facts_cache(args, settings) as cache:
         report = run_scan(request, NoProgress(), cache)
     assert report.coupling is not None
-    emit(render(report.coupling.graph, args.format), args.output)
+    view = args.view
+    if view is None:
+        named = any(s.name for c in report.coupling.elements for s in c.link_sites)
+        view = "computation" if named else "elements"
+    graph = report.coupling.graph if view == "elements" else computation_graph(report.coupling)
+    emit(render(graph, args.format), args.output)
     return EXIT_OK
 
 

@@ -60,6 +60,16 @@ def add_config_from(parser: argparse.ArgumentParser, base: str, head: str) -> No
     )
 
 
+def add_group(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--group",
+        choices=["component", "file", "package", "node"],
+        default=None,
+        help="what one element is: a C/C++ header and its source (component, the default), a"
+        " file, a ROS package (the folder holding package.xml) or a ROS node's files",
+    )
+
+
 def add_exclude(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--exclude",

@@ -15,6 +15,7 @@ from archmetrics.cli.options import (
     add_config_from,
     add_exclude,
     add_format,
+    add_group,
     add_history,
     add_locations,
     add_max_rows,
@@ -71,6 +72,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_output(scan, [f.value for f in OutputFormat])
     add_baseline(scan)
     add_allow_raised_limits(scan)
+    add_group(scan)
     baseline = commands.add_parser(
         "baseline",
         help="write the offenders of thresholds to a file, so that scan and diff --baseline"
@@ -123,6 +125,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_chart(diff)
     add_output(diff, [f.value for f in OutputFormat])
     add_max_rows(diff)
+    add_group(diff)
     add_baseline(diff)
     add_allow_raised_limits(diff)
     add_config_from(diff, "--base's", "--head's")
@@ -222,7 +225,16 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_argument("--jobs", "-j", type=int, default=0, help="parser processes (0: per core)")
     graph.add_argument("--no-cache", action="store_true", help="parse everything, store nothing")
     graph.add_argument("--cache-path", type=Path, help="the facts cache file to use")
+    graph.add_argument(
+        "--view",
+        choices=["elements", "computation"],
+        default=None,
+        help="elements: who depends on and talks to whom; computation: elements and the"
+        " topics, services, actions and plugins between them, as rqt_graph draws a ROS graph"
+        " (default: computation when the tree has ROS sites, else elements)",
+    )
     add_exclude(graph)
+    add_group(graph)
     add_allow_raised_limits(graph)
     docs = commands.add_parser(
         "docs", help="the documentation installed with archmetrics: list the pages, print one"

@@ -20,14 +20,18 @@ from archmetrics.coupling.elements import Element
 from archmetrics.coupling.endpoints import normalize
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
 from archmetrics.coupling.patterns import SlowPattern, search
+from archmetrics.coupling.roslaunch import table_launched
 from archmetrics.coupling.rules import ConfigEndpoint, ConfigRule
 from archmetrics.facts import ConfigTable, FileFacts
+from archmetrics.globs import glob_matches
 
 
 def config_link_sites(facts: FileFacts, rules: Sequence[ConfigRule]) -> tuple[LinkSite, ...]:
-    """The link sites of one configuration file under ``rules`` (those of its format)."""
-    usable = [rule for rule in rules if rule.format == facts.language]
-    found: list[LinkSite] = []
+    """The link sites of one configuration file under ``rules`` (those of its format): the
+    tables the generic rules select, and what the first rule of each interpreter whose
+    ``files`` name the file reads (a launch file's nodes, roslaunch.py)."""
+    usable = [rule for rule in rules if rule.format == facts.language and not rule.interpret]
+    found: list[LinkSite] = list(_interpreted(facts, rules))
     for table in facts.tables if usable else ():
         rule = next((r for r in usable if _selects(r, table)), None)
         if rule is None:
@@ -39,6 +43,43 @@ def config_link_sites(facts: FileFacts, rules: Sequence[ConfigRule]) -> tuple[Li
                          ".".join(table.keys), endpoint, LinkStatus.UNRESOLVED, note=note)
             )  # fmt: skip
     return tuple(sorted(found, key=lambda s: (s.line, s.rule)))
+
+
+def _interpreted(facts: FileFacts, rules: Sequence[ConfigRule]) -> list[LinkSite]:
+    seen: set[str] = set()
+    found: list[LinkSite] = []
+    for rule in rules:
+        if rule.interpret is None or rule.interpret in seen or rule.format != facts.language:
+            continue
+        if not any(glob_matches(glob, facts.path) for glob in rule.files):
+            continue
+        seen.add(rule.interpret)
+        if rule.interpret == "ros-launch":
+            for entry in table_launched(facts):
+                point = Endpoint(entry.key, entry.plugin or entry.executable, "configuration")
+                callee = "composable_node" if entry.plugin else "node"
+                found.append(LinkSite(facts.path, entry.line, rule.qualified_id, rule.kind,
+                                      rule.role, callee, point, LinkStatus.UNRESOLVED))  # fmt: skip
+        elif rule.interpret == "pluginlib":
+            found.extend(_described(facts, rule))
+    return found
+
+
+def _described(facts: FileFacts, rule: ConfigRule) -> list[LinkSite]:
+    """A plugin description's classes (``<library><class name=... type=...>``): one site
+    each, its endpoint the C++ class (``type``) as the loads of its lookup name (``name``,
+    kept as the endpoint's text) resolve to it, receiving them."""
+    found = []
+    for table in facts.tables:
+        if table.keys[-1:] != ("class",) or table.keys[0] not in ("library", "class_libraries"):
+            continue
+        kind = (table.get("type") or table.get("name") or ("",))[0]
+        lookup = (table.get("name") or table.get("type") or ("",))[0]
+        if kind:
+            point = Endpoint(f"plugin:{kind}", lookup, "configuration")
+            found.append(LinkSite(facts.path, table.line, rule.qualified_id, rule.kind,
+                                  rule.role, "class", point, LinkStatus.UNRESOLVED))  # fmt: skip
+    return found
 
 
 def with_config_sites(

@@ -4,20 +4,43 @@ Every call (or, for ``site = "definition"`` rules, function definition) matching
 link site, +1 to its element's d_e (thesis page 110: "for each occurrence"). A call matches at
 most one rule: the matching rule with the highest ``priority``, ties going to load order.
 An initiating site with endpoint key k links into every other element holding a receiving
-site with key k; d_a of an element counts the other elements' sites linking into it.
+site with key k (or receiving k without a site: a parameter file, rosgraph.py); d_a of an
+element counts the other elements' sites linking into it. Which rule a call matches is
+matching.py's; graph names and data types are graphnames.py's; a call on an object made by
+another call takes that call's endpoint (receivers.py).
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import replace
-from functools import lru_cache
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field, replace
 
 from archmetrics.coupling.endpoints import normalize
+from archmetrics.coupling.graphnames import (
+    TypeAliases,
+    completed,
+    data_type,
+    graph_endpoint,
+    imported_names,
+    qualified,
+    through_alias,
+)
+from archmetrics.coupling.matching import (
+    Requirements,
+    RuleIndex,
+    choose_rule,
+    constructed,
+    matches,
+    member,
+    normalize_callee,
+    requirement_forms,
+    requirement_met,
+    rule_index,
+)
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
 from archmetrics.coupling.patterns import SlowPattern, search
+from archmetrics.coupling.receivers import Found, bound_to_makers, invoked
 from archmetrics.coupling.rules import (
     EndpointSource,
     EndpointSpec,
@@ -27,163 +50,30 @@ from archmetrics.coupling.rules import (
     RuleSet,
     SiteKind,
 )
+from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.trace import AMBIGUOUS, ArgumentReader
-from archmetrics.facts import Argument, CallSite, FileFacts
-from archmetrics.globs import compile_glob, compile_globs
+from archmetrics.facts import Argument, CallSite, FileFacts, Language
 
-if TYPE_CHECKING:
-    from pathspec import GitIgnoreSpec
+__all__ = [
+    "AmbiguousEndpoint", "FileContext", "LinkFilter", "RuleIndex", "choose_rule",
+    "file_link_sites", "matches", "normalize_callee", "read_endpoint", "requirement_forms",
+    "requirement_met", "resolve", "rule_index",
+]  # fmt: skip
 
 
 class AmbiguousEndpoint(Exception):
     """The endpoint's name is given several values (e.g. by different callers)."""
 
 
-_SPECIAL = re.compile(r"[\s()<>:]|->")
-_TEMPLATE = re.compile(r"<[^<>]*>")
-_PARENS = re.compile(r"\([^()]*\)")
+@dataclass(frozen=True, slots=True)
+class FileContext:
+    """What resolving a file's graph names needs: its naming scopes and, in Python, the names
+    its imports bind (a type written ``Twist`` is ``geometry_msgs.msg.Twist``), in C and C++
+    its type aliases."""
 
-
-def _strip_nested(pattern: re.Pattern[str], text: str, empty: str) -> str:
-    previous = None
-    while previous != text:
-        previous, text = text, pattern.sub(empty, text)
-    return text
-
-
-@lru_cache(maxsize=1 << 16)
-def normalize_callee(callee: str) -> str:
-    """A callee as rules see it: no spaces, no template arguments, ``->``/``::`` as ``.``."""
-    if not _SPECIAL.search(callee):
-        return callee.lstrip(".")
-    text = re.sub(r"\s+", "", callee)
-    text = _strip_nested(_PARENS, _strip_nested(_TEMPLATE, text, ""), "()")
-    return text.replace("->", ".").replace("::", ".").lstrip(".")
-
-
-@lru_cache(maxsize=65536)
-def _normalized(callee: str) -> tuple[str, str]:
-    """A callee normalized, and the last part of that (callees repeat across files)."""
-    name = normalize_callee(callee)
-    return name, name.rsplit(".", 1)[-1]
-
-
-@lru_cache(maxsize=4096)
-def _compiled(pattern: str) -> GitIgnoreSpec:
-    """A rule's ``match`` glob, in the one glob dialect (archmetrics.globs): a callee name
-    has no ``/``, so ``*`` takes any run of it, dots included."""
-    return compile_glob(normalize_callee(pattern))
-
-
-@lru_cache(maxsize=65536)
-def matches(pattern: str, callee: str) -> bool:
-    """Whether a rule pattern (``zmq_connect``, ``*.connect``, ``socket.socket``) matches:
-    a pattern without a wild card is the normalized name itself; the answer is kept (a
-    function's calls are tried against each hint of each of its sites)."""
-    name, _ = _normalized(callee)
-    if not any(c in pattern for c in "*?[\\") and not pattern.startswith(("!", "#")):
-        return name == normalize_callee(pattern)
-    return _compiled(pattern).match_file(name)
-
-
-def requirement_forms(dependencies: Iterable[str]) -> frozenset[str]:
-    """Every way a ``requires`` entry can name a dependency: the dependency itself, its dotted
-    prefixes (``zmq`` for ``zmq.asyncio``) and path suffixes (``playerc.h`` for
-    ``libplayerc/playerc.h``)."""
-    forms: set[str] = set()
-    for dep in dependencies:
-        parts = dep.split(".")
-        forms.update(".".join(parts[: i + 1]) for i in range(len(parts)))
-        pieces = dep.split("/")
-        forms.update("/".join(pieces[i:]) for i in range(len(pieces)))
-    return frozenset(forms)
-
-
-def requirement_met(requires: Iterable[str], dependencies: Iterable[str]) -> bool:
-    """Whether a file that sees ``dependencies`` satisfies a rule's ``requires`` list."""
-    wanted = tuple(requires)
-    forms = requirement_forms(dependencies) if wanted else frozenset()
-    return not wanted or any(want in forms for want in wanted)
-
-
-WILD_ANSWERS = 200_000  # names whose wild-card answer a rule index keeps
-
-
-class RuleIndex:
-    """Rules indexed by the last name their patterns match, so a call is tried on a few."""
-
-    def __init__(self, rules: Sequence[Rule]) -> None:
-        self.by_name: dict[str, list[tuple[int, Rule, str]]] = {}
-        self.wild: list[tuple[int, Rule, str]] = []
-        self.chosen: dict[tuple[str, bool], Rule | None] = {}  # callees repeat: ask once
-        # the wild-card patterns' answer per name, kept for the process: within one tree
-        # names seldom repeat, but a history meets the same files' names at every commit
-        self._wild_answers: dict[str, bool] = {}
-        for order, rule in enumerate(rules):
-            for pattern in rule.match:
-                last = normalize_callee(pattern).rsplit(".", 1)[-1]
-                entry = (order, rule, pattern)
-                if any(c in last for c in "*?["):
-                    self.wild.append(entry)
-                else:
-                    self.by_name.setdefault(last, []).append(entry)
-        wild = tuple(normalize_callee(pattern) for _, _, pattern in self.wild)
-        self._wild = compile_globs(wild) if wild else None
-
-    def may_match(self, callees: Iterable[str]) -> bool:
-        """Whether a rule could match one of ``callees`` (True may be wrong, False never is):
-        a name's last part is one a rule's pattern ends in, or a wildcard pattern matches it.
-        One set look-up a callee, where ``choose`` tries each candidate rule's pattern."""
-        if self._wild is None and not self.by_name:
-            return False
-        by_name, wild, answers = self.by_name, self._wild, self._wild_answers
-        for callee in callees:
-            name, last = _normalized(callee)
-            if last in by_name:
-                return True
-            if wild is None:
-                continue
-            answer = answers.get(name)
-            if answer is None:
-                if len(answers) >= WILD_ANSWERS:
-                    answers.clear()
-                answer = answers[name] = wild.match_file(name)
-            if answer:
-                return True
-        return False
-
-    def choose(self, callee: str, module_receiver: bool = False) -> Rule | None:
-        """The rule a callee matches: highest priority first, then load order.
-
-        With ``module_receiver`` (the receiver is a module name) ``*``-patterns do not match.
-        """
-        key = (callee, module_receiver)
-        if key in self.chosen:
-            return self.chosen[key]
-        rule = self.chosen[key] = self._choose(normalize_callee(callee), module_receiver)
-        return rule
-
-    def _choose(self, name: str, module_receiver: bool) -> Rule | None:
-        best: tuple[int, int, Rule] | None = None
-        for order, rule, pattern in (*self.by_name.get(name.rsplit(".", 1)[-1], ()), *self.wild):
-            if module_receiver and pattern.startswith("*"):
-                continue
-            rank = (rule.priority, -order)
-            if (best is None or rank > best[:2]) and _compiled(pattern).match_file(name):
-                best = (*rank, rule)
-        return best[2] if best else None
-
-
-@lru_cache(maxsize=256)
-def rule_index(rules: tuple[Rule, ...]) -> RuleIndex:
-    """The index of these rules, shared by every file that can use the same ones (rules are
-    frozen values, so equal tuples index alike)."""
-    return RuleIndex(rules)
-
-
-def choose_rule(callee: str, rules: Sequence[Rule], module_receiver: bool = False) -> Rule | None:
-    """The rule a callee matches: highest priority first, then load order."""
-    return RuleIndex(rules).choose(callee, module_receiver)
+    scopes: FileScopes
+    imports: Mapping[str, str] = field(default_factory=dict)
+    aliases: TypeAliases | None = None  # C++: the file's type aliases
 
 
 def _pick(arguments: Sequence[Argument], index: int | None, keyword: str | None) -> Argument | None:
@@ -264,6 +154,10 @@ def _read_endpoint(
         found = _first_matching(call, spec, read)
     else:
         found = _key_from(_pick(call.arguments, spec.arg, spec.keyword), spec, read, call)
+        for index in spec.more_args if found is None else ():
+            found = _key_from(_pick(call.arguments, index, None), spec, read, call)
+            if found is not None:
+                break
     if found is None and spec.same_function:
         found = _from_function(call, spec.same_function, spec, calls, read)
     return found
@@ -289,6 +183,10 @@ class LinkFilter:
         calls, definitions = indexes
         if calls.may_match(facts.callees()):
             return True
+        if facts.language == Language.PYTHON and facts.dependencies:  # callees as imported
+            imports = imported_names(facts.dependencies)
+            if imports and calls.may_match(qualified(c, imports) for c in facts.callees()):
+                return True
         return definitions.may_match(f.qualified_name for f in facts.functions)
 
 
@@ -298,24 +196,35 @@ def file_link_sites(
     visible: Iterable[str],
     read: ArgumentReader,
     modules: frozenset[str] = frozenset(),
+    context: FileContext | None = None,
 ) -> tuple[LinkSite, ...]:
     """The unresolved-yet link sites of one file (status and targets are set by ``resolve``)."""
-    forms = requirement_forms(visible)
-    usable = [
-        r for r in rules.for_language(facts.language)
-        if not r.requires or any(want in forms for want in r.requires)
-    ]  # fmt: skip
+    seen = Requirements(visible)
+    usable = [r for r in rules.for_language(facts.language) if seen.met(r.requires)]
     calls = rule_index(tuple(r for r in usable if r.site is SiteKind.CALL))
-    found: list[tuple[Rule, LinkSite]] = []
+    found: list[Found] = []
     # a file none of whose callees a rule names has no call site to read (nor to decode)
-    readable = facts.call_sites if any(map(calls.choose, facts.callees())) else ()
+    readable = facts.call_sites if calls.may_match(facts.callees()) else ()
     for call in readable:
+        callee, _ = constructed(call)
         receiver = normalize_callee(call.receiver) if call.receiver else None
-        rule = calls.choose(call.callee, receiver in modules)
+        rule = calls.choose(callee, receiver in modules)
+        if rule is None and context is not None and context.imports:  # as imported: a
+            # module's function, which no ``*.name`` pattern (a method on any object) names
+            named = qualified(callee, context.imports)
+            rule = calls.choose(named, True) if named != callee else None
+        elif rule is None and context is not None and context.aliases is not None:
+            aliased = through_alias(call, context.aliases)  # made through a type alias
+            rule = calls.choose(aliased.callee) if aliased is not None else None
+            call = aliased if rule is not None and aliased is not None else call
         if rule and not (rule.unless_from and _assigned_from(facts, call, rule.unless_from)):
-            endpoint, note = read_endpoint(call, rule.endpoint, facts.call_sites, read)
-            site = _site(facts.path, call.span.start, rule, call.callee, endpoint, call.function)
-            found.append((rule, replace(site, note=note)))
+            if _bare(call, rule):
+                continue
+            found.append(Found(rule, _call_site(facts, call, rule, read, context), call))
+    made = {member(f.call.target) for f in found if f.call is not None and f.call.target}
+    for call in readable if made else ():
+        if (called := invoked(call, made)) and (rule := calls.choose(called.callee)):
+            found.append(Found(rule, _call_site(facts, called, rule, read, context), called))
     definitions = rule_index(tuple(r for r in usable if r.site is SiteKind.DEFINITION))
     for function in facts.functions:
         if rule := definitions.choose(function.qualified_name):
@@ -327,9 +236,86 @@ def file_link_sites(
                 except SlowPattern as slow:
                     note = str(slow)
             site = _site(facts.path, function.span.start, rule, name, endpoint, name)
-            found.append((rule, replace(site, note=note)))
-    sites = [_from_file(rule, site, found) for rule, site in found]
-    return tuple(sorted(sites, key=lambda s: (s.line, s.rule)))
+            found.append(Found(rule, replace(site, note=note), None))
+    pairs = [(f.rule, f.site) for f in found]
+    found = [Found(f.rule, _from_file(f.rule, f.site, pairs), f.call) for f in found]
+    found = [_fallback(f, context) for f in bound_to_makers(found, facts)]
+    return tuple(sorted((f.site for f in found), key=lambda s: (s.line, s.rule)))
+
+
+def _call_site(
+    facts: FileFacts, call: CallSite, rule: Rule, read: ArgumentReader, context: FileContext | None
+) -> LinkSite:
+    """The link site ``call`` is under ``rule``: its endpoint read, its graph name resolved
+    and its data type read where the rule says so."""
+    spec = rule.endpoint
+    endpoint, note = read_endpoint(call, spec, facts.call_sites, read)
+    if (
+        endpoint is None
+        and not note
+        and spec is not None
+        and not spec.created_by
+        and (spec.naming or spec.type in _SAID)
+    ):
+        note = _unknown(call, spec)  # graph names, plugins, launched nodes: always said why
+    site = replace(_site(facts.path, call.span.start, rule, call.callee, endpoint, call.function),
+                   note=note)  # fmt: skip
+    if spec is None or context is None or not (spec.naming or spec.value or spec.data_type):
+        return site
+    kind = data_type(call, spec.data_type, context.imports, spec.naming == "ros1", context.aliases)
+    if spec.naming == "ros1" and spec.type == "action":  # actionlib's MoveBaseAction
+        kind = kind.removesuffix("Action")  # is the action move_base_msgs/MoveBase
+    if spec.created_by and endpoint is None:
+        return replace(site, data_type=kind)  # its maker gives it (receivers.py)
+    parameter = endpoint.via.partition(":")[2] if endpoint and endpoint.via.startswith(
+        "parameter:") else ""  # fmt: skip
+    named = graph_endpoint(spec, call, endpoint, note, context.scopes)
+    return completed(site, named, kind, parameter)
+
+
+_SAID = frozenset({"plugin", "node"})
+
+
+def _bare(call: CallSite, rule: Rule) -> bool:
+    """A call without arguments where a graph-name rule reads its name from one
+    (``filter->subscribe()`` re-subscribing a subscriber made elsewhere): no new link."""
+    spec = rule.endpoint
+    return (
+        spec is not None and spec.naming is not None and not call.arguments
+        and (spec.arg is not None or spec.keyword is not None)
+        and not spec.value and not spec.created_by
+    )  # fmt: skip
+
+
+def _unknown(call: CallSite, spec: EndpointSpec) -> str:
+    """Why a call's endpoint could not be read (docs/metrics.md: never dropped, never a
+    guess): the argument is missing, or it is computed."""
+    if spec.value or spec.source is EndpointSource.CALLEE or (spec.arg is None and spec.keyword
+                                                              is None):  # fmt: skip
+        return ""
+    argument = _pick(call.arguments, spec.arg, spec.keyword)
+    if argument is None:
+        where = " or ".join(
+            p for p in (f"argument {spec.arg}" if spec.arg is not None else "",
+                        f"{spec.keyword}=" if spec.keyword else "") if p
+        )  # fmt: skip
+        return f"no {where}: the name is not given here"
+    return (
+        f"{argument.text}: computed at run time (no literal, constant or value traced in this file)"
+    )
+
+
+def _fallback(item: Found, context: FileContext | None) -> Found:
+    """A site on an object that no call of the file made takes its rule's fixed ``value``
+    (a tf broadcaster's ``sendTransform``: ``/tf``)."""
+    spec = item.rule.endpoint
+    if (
+        spec is None or not spec.value or not spec.created_by or item.site.endpoint is not None
+        or item.call is None or context is None or item.site.note.startswith("made by several")
+    ):  # fmt: skip
+        return item
+    named = graph_endpoint(spec, item.call, None, "", context.scopes)
+    return Found(item.rule, completed(item.site, named, item.site.data_type, ""), item.call)
 
 
 def _assigned_from(facts: FileFacts, call: CallSite, producers: Sequence[str]) -> bool:
@@ -375,14 +361,18 @@ def _site(path: str, line: int, rule: Rule, callee: str, endpoint: Endpoint | No
 
 def resolve(
     sites_by_element: Mapping[str, tuple[LinkSite, ...]],
+    implicit: Mapping[str, frozenset[str]] | None = None,
 ) -> dict[str, tuple[LinkSite, ...]]:
-    """Set status and targets: initiating keys meet receiving keys in other elements."""
-    receivers: dict[str, set[str]] = {}
+    """Set status and targets: initiating keys meet receiving keys in other elements (a
+    receiving site's ``also`` keys too), and the ``implicit`` receivers of a key (elements
+    receiving it without a site: a parameter file, an executable a launch file starts)."""
+    receivers: dict[str, set[str]] = {k: set(v) for k, v in (implicit or {}).items()}
     initiators: dict[str, set[str]] = {}
     for element, sites in sites_by_element.items():
         for site in sites:
             if site.endpoint is not None and site.role is Role.RECEIVE:
-                receivers.setdefault(site.endpoint.key, set()).add(element)
+                for key in (site.endpoint.key, *site.endpoint.also):
+                    receivers.setdefault(key, set()).add(element)
             if site.endpoint is not None and site.role is Role.INITIATE:
                 initiators.setdefault(site.endpoint.key, set()).add(element)
     return {
@@ -399,7 +389,8 @@ def _resolved(site: LinkSite, element: str, receivers: Mapping[str, set[str]],
         return replace(site, status=LinkStatus.UNRESOLVED)
     key = site.endpoint.key
     if site.role is Role.RECEIVE:
-        linked = initiators.get(key, set()) - {element}
+        keys = (key, *site.endpoint.also)
+        linked = set().union(*(initiators.get(k, set()) for k in keys)) - {element}
         status = LinkStatus.RESOLVED if linked else LinkStatus.EXTERNAL
         return replace(site, status=status)
     targets = tuple(sorted(receivers.get(key, set()) - {element}))

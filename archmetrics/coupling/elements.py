@@ -55,9 +55,14 @@ def _languages(files: Iterable[str], language_of: Callable[[str], str | None]) -
     return tuple(sorted({lang for f in files if (lang := language_of(f))}))
 
 
+COMPONENT, FILE, PACKAGE, NODE = "component", "file", "package", "node"
+GROUPINGS = (COMPONENT, FILE, PACKAGE, NODE)
+MANIFEST = "package.xml"  # a folder holding one is a ROS package
+
+
 def group_elements(
     paths: Iterable[str],
-    per_file: bool = False,
+    per_file: bool | str = False,
     language_of: Callable[[str], str | None] | None = None,
 ) -> tuple[Element, ...]:
     """Group tree-relative paths into elements, sorted by name.
@@ -66,16 +71,29 @@ def group_elements(
     its folder and stem, ``src/foo`` for ``src/foo.c`` + ``src/foo.h`` (also when only one
     of them exists, so adding a header later keeps the name). If a stem name equals the path
     of another file (``a/b.py`` next to ``a/b.py.c``), the component is named by its brace
-    list instead (``a/b.py.{c}``). With ``per_file`` every element is named by its path.
+    list instead (``a/b.py.{c}``). ``per_file`` is the grouping: True or ``"file"``, every
+    element is named by its path; ``"package"``, the files of a ROS package (the deepest
+    folder above them holding ``package.xml``) are one element named by its folder;
+    ``"node"``, in a ROS package the C/C++ files of one stem (``include/pkg/talker.hpp``
+    and ``src/talker.cpp``, the class of a node) are one element named ``<package>/<stem>``.
+    Files outside any package are grouped as components.
     """
     lang_of = language_of or _default_language
     unique = sorted(set(paths))
-    if per_file:
+    grouping = FILE if per_file is True else (per_file or COMPONENT)
+    if grouping == FILE:
         return tuple(Element(p, (p,), _languages((p,), lang_of)) for p in unique)
+    packages = _packages(unique) if grouping in (PACKAGE, NODE) else set()
     groups: dict[str, list[str]] = {}
     singles: list[str] = []
     for path in unique:
-        if _is_c_family(path):
+        package = _package_of(path, packages) if packages else None
+        if package is not None and grouping == PACKAGE:
+            groups.setdefault(package or ".", []).append(path)
+        elif package is not None and _is_c_family(path):
+            stem = component_name(path).rpartition("/")[2]
+            groups.setdefault(f"{package}/{stem}" if package else stem, []).append(path)
+        elif _is_c_family(path):
             groups.setdefault(component_name(path), []).append(path)
         else:
             singles.append(path)
@@ -85,6 +103,22 @@ def group_elements(
         name = stem if stem not in taken else _brace_name(stem, files)
         elements.append(Element(name, tuple(files), _languages(files, lang_of)))
     return tuple(sorted(elements))
+
+
+def _packages(paths: list[str]) -> set[str]:
+    """The folders holding a ``package.xml`` ("" for the root)."""
+    return {p.rpartition("/")[0] for p in paths if p.rpartition("/")[2] == MANIFEST}
+
+
+def _package_of(path: str, packages: set[str]) -> str | None:
+    """The deepest package folder above ``path``, or None."""
+    folder = path.rpartition("/")[0]
+    while True:
+        if folder in packages:
+            return folder
+        if not folder:
+            return None
+        folder = folder.rpartition("/")[0]
 
 
 def _brace_name(stem: str, files: list[str]) -> str:

@@ -22,6 +22,7 @@ Value = str | int | float | bool | bytes | tuple[object, ...]
 Lookup = Callable[[str], Value | None]
 
 _NAME = re.compile(r"^[A-Za-z_]\w*$")
+_NAMED_LITERALS = frozenset({"True", "False", "None"})
 _PORT = re.compile(r":(\d{1,5})(?:/.*)?$")
 _ICE_PORT = re.compile(r"-p\s+(\d{1,5})\b")
 _LIBRARY_SUFFIX = re.compile(r"(\.so(\.\d+)*|\.dll|\.dylib|\.\d+)+$", re.IGNORECASE)
@@ -49,6 +50,15 @@ def _kept_literal(text: str) -> Value | None:
 
 def _literal(text: str) -> Value | None:
     text = text.strip()
+    first = text[:1]
+    if (
+        (first.isalpha() or first == "_")
+        and text not in _NAMED_LITERALS
+        and not (
+            "'" in text or '"' in text  # b'x', r"x": a prefixed string literal
+        )
+    ):
+        return None  # a name, a call, a member: no literal (and no parse to learn it)
     if text.startswith("(") and text.endswith(")") and text.count(",") == 0:
         text = text[1:-1].strip()  # C's (3490) and Python's ("x")
     try:
@@ -132,7 +142,7 @@ def _port(value: Value) -> int | None:
         return None
     if isinstance(value, int):
         return value if 0 <= value < 65536 else None
-    if isinstance(value, str) and value.strip().isdigit():
+    if isinstance(value, str) and value.strip().isascii() and value.strip().isdigit():
         return _port(int(value.strip()))
     if isinstance(value, tuple) and len(value) >= 2 and isinstance(value[1], int | str):
         return _port(value[1])

@@ -20,7 +20,7 @@ rules are measure.py's, restated per element:
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from archmetrics.coupling.config_links import config_link_sites
@@ -35,6 +35,7 @@ from archmetrics.facts import FileFacts
 
 Site = tuple[str, str | None]  # one link site: its role and its endpoint's key (None: unknown)
 Values = tuple[int, int, int, int]  # s_a, s_e, d_a, d_e
+ALSO = "also"  # a record of a key a receiving site also receives (no site of its own)
 
 _INITIATE, _RECEIVE = Role.INITIATE.value, Role.RECEIVE.value
 
@@ -58,6 +59,8 @@ class CouplingIndex:
     deps: Mapping[str, tuple[Dep, ...]]
     sites: Mapping[str, tuple[Site, ...]]
     values: Mapping[str, Values]
+    receivers: Mapping[str, frozenset[str]] = field(default_factory=dict)  # TreeLinks'
+    whole: bool = False  # a patch couples the tree whole (TreeLinks.whole)
 
 
 def _deps(occurrences: Iterable[Occurrence]) -> tuple[Dep, ...]:
@@ -65,7 +68,12 @@ def _deps(occurrences: Iterable[Occurrence]) -> tuple[Dep, ...]:
 
 
 def _sites(sites: Iterable[LinkSite]) -> tuple[Site, ...]:
-    return tuple((s.role.value, s.endpoint.key if s.endpoint else None) for s in sites)
+    found: list[Site] = []
+    for s in sites:
+        found.append((s.role.value, s.endpoint.key if s.endpoint else None))
+        if s.endpoint is not None and s.role is Role.RECEIVE:
+            found += [(ALSO, key) for key in s.endpoint.also]
+    return tuple(found)
 
 
 def build_index(links: TreeLinks, paths: Sequence[str]) -> CouplingIndex:
@@ -76,9 +84,11 @@ def build_index(links: TreeLinks, paths: Sequence[str]) -> CouplingIndex:
         for site in element_sites:
             by_file.setdefault(site.path, []).append(site)
     sites = {path: _sites(found) for path, found in by_file.items()}
-    counter = _Counter(_Names(links.elements), deps, sites)
+    counter = _Counter(_Names(links.elements), deps, sites, links.receivers)
     values = {e.name: counter.values(e) for e in links.elements}
-    return CouplingIndex(tuple(paths), links.elements, deps, sites, values)
+    return CouplingIndex(
+        tuple(paths), links.elements, deps, sites, values, links.receivers, links.whole
+    )
 
 
 class _Names:
@@ -97,10 +107,16 @@ class _Counter:
         names: _Names,
         deps: Mapping[str, tuple[Dep, ...]],
         sites: Mapping[str, tuple[Site, ...]],
+        implicit: Mapping[str, frozenset[str]] | None = None,
     ) -> None:
         self.element_of, self.by_name = names.element_of, names.by_name
         self.deps, self.sites = deps, sites
-        self.receivers: dict[str, set[str]] = {}  # endpoint key -> elements receiving it
+        self.implicit: dict[str, set[str]] = {}  # element -> keys it receives without a site
+        for received, receiving in (implicit or {}).items():
+            for element in receiving:
+                self.implicit.setdefault(element, set()).add(received)
+        # endpoint key -> elements receiving it
+        self.receivers: dict[str, set[str]] = {k: set(v) for k, v in (implicit or {}).items()}
         self.initiated: dict[str, int] = {}  # endpoint key -> initiating sites, all elements
         self.initiated_by: dict[tuple[str, str], int] = {}  # (element, key) -> its sites
         for path, found in sites.items():
@@ -108,7 +124,7 @@ class _Counter:
             for role, key in found:
                 if key is None:
                     continue
-                if role == _RECEIVE:
+                if role in (_RECEIVE, ALSO):
                     self.receivers.setdefault(key, set()).add(name)
                 elif role == _INITIATE:
                     self.initiated[key] = self.initiated.get(key, 0) + 1
@@ -131,15 +147,17 @@ class _Counter:
         return len(keys), others
 
     def d_e(self, element: Element) -> int:
-        return sum(len(self.sites.get(path, ())) for path in element.files)
+        return sum(
+            1 for path in element.files for role, _ in self.sites.get(path, ()) if role != ALSO
+        )
 
     def d_a(self, name: str) -> int:
         received = {
             key
             for path in self.by_name[name].files
             for role, key in self.sites.get(path, ())
-            if role == _RECEIVE and key is not None
-        }
+            if role in (_RECEIVE, ALSO) and key is not None
+        } | self.implicit.get(name, set())
         initiated, mine = self.initiated, self.initiated_by
         return sum(initiated.get(key, 0) - mine.get((name, key), 0) for key in received)
 
@@ -154,8 +172,6 @@ class _Counter:
     def values(self, element: Element) -> Values:
         s_e = self.targets(element)[0]
         return (self.s_a(element.name), s_e, self.d_a(element.name), self.d_e(element))
-
-
 
 
 class LazyFacts(Mapping[str, FileFacts]):
@@ -254,7 +270,9 @@ def patch_index(
     sites = {p: s for p, s in index.sites.items() if p not in affected}
     sites.update((p, _sites(f)) for p, f in redone.items() if f)
     values = _patched_values(index, deps, sites, changed, affected, names)
-    return CouplingIndex(index.paths, index.elements, deps, sites, values)
+    return CouplingIndex(
+        index.paths, index.elements, deps, sites, values, index.receivers, index.whole
+    )
 
 
 class _Overlay(Mapping[str, tuple[Dep, ...]]):
@@ -349,8 +367,8 @@ def _patched_values(
     affected: Collection[str],
     names: _Names,
 ) -> dict[str, Values]:
-    before = _Counter(names, index.deps, index.sites)
-    after = _Counter(names, deps, sites)
+    before = _Counter(names, index.deps, index.sites, index.receivers)
+    after = _Counter(names, deps, sites, index.receivers)
     element_of = after.element_of
     redeps = {element_of[p] for p in changed}  # s_e and the targets of s_a
     resites = {element_of[p] for p in affected if p in sites or p in index.sites}

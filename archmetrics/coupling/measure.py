@@ -4,14 +4,15 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 from archmetrics.coupling.bindings import module_bindings
 from archmetrics.coupling.config_links import with_config_sites
-from archmetrics.coupling.dynamic import LinkFilter, file_link_sites, resolve
+from archmetrics.coupling.dynamic import FileContext, LinkFilter, file_link_sites, resolve
 from archmetrics.coupling.elements import Element, element_of_file, group_elements
 from archmetrics.coupling.endpoints import Lookup, Value, constants_of
+from archmetrics.coupling.graphnames import TypeAliases, imported_names
 from archmetrics.coupling.model import (
     CouplingOptions,
     CouplingReport,
@@ -22,7 +23,9 @@ from archmetrics.coupling.model import (
     LinkSite,
     StaticDependency,
 )
+from archmetrics.coupling.rosgraph import ros_graph
 from archmetrics.coupling.rules import Role, RuleSet
+from archmetrics.coupling.scopes import FileScopes
 from archmetrics.coupling.sitememo import SiteMemo, decode_sites, encode_sites, site_key
 from archmetrics.coupling.static import (
     Occurrence,
@@ -31,6 +34,7 @@ from archmetrics.coupling.static import (
     element_dependencies,
 )
 from archmetrics.coupling.trace import Tracer
+from archmetrics.coupling.values import ValueCalls
 from archmetrics.facts import FileFacts, Language
 
 _C_FAMILY = frozenset({Language.C.value, Language.CPP.value})
@@ -57,6 +61,9 @@ class TreeLinks:
     elements: tuple[Element, ...]
     occurrences: Mapping[str, tuple[Occurrence, ...]]
     sites: Mapping[str, tuple[LinkSite, ...]]  # by element name
+    # keys elements receive without a site of theirs (a parameter file; rosgraph.py)
+    receivers: Mapping[str, frozenset[str]] = field(default_factory=dict)
+    whole: bool = False  # the tree's configuration renamed sites: a patch couples it whole
 
 
 def link_tree(
@@ -70,7 +77,7 @@ def link_tree(
     rules = rules or RuleSet()
     by_path = {f.path: f for f in files}
     languages = {f.path: f.language for f in files}
-    elements = group_elements(by_path, options.per_file, languages.get)
+    elements = group_elements(by_path, options.grouping, languages.get)
     resolver = StaticResolver(tuple(by_path), options)
     occurrences = {path: resolver.resolve_file(facts) for path, facts in by_path.items()}
     may_link = LinkFilter(rules)
@@ -81,7 +88,8 @@ def link_tree(
         found[element.name].extend(by_file[path])
     code = {name: tuple(s) for name, s in found.items()}
     sites = with_config_sites(code, elements, by_path, rules.configuration)
-    return TreeLinks(elements, occurrences, sites)
+    graph = ros_graph(sites, elements, by_path)
+    return TreeLinks(elements, occurrences, graph.sites, graph.receivers, graph.applied)
 
 
 def measure_coupling(
@@ -102,7 +110,7 @@ def measure_coupling(
     dependencies = {
         e.name: element_dependencies(e, links.occurrences, element_of) for e in elements
     }
-    sites = resolve({e.name: links.sites[e.name] for e in elements})
+    sites = resolve({e.name: links.sites[e.name] for e in elements}, links.receivers)
     afferent = dependents(dependencies)
     incoming = _incoming(sites)
     return CouplingReport(
@@ -202,8 +210,17 @@ class Sites:
         submodules = [o.name for o in occurrences.get(path, ()) if o.target_file]
         python = facts.language == Language.PYTHON
         modules = module_bindings(facts.dependencies, submodules) if python else frozenset()
-        tracer = Tracer(facts, lookup, modules)
-        return file_link_sites(facts, self.rules, sorted(visible), tracer.read, modules)
+        values = ValueCalls(facts, self.rules.values) if self.rules.values else None
+        tracer = Tracer(facts, lookup, modules, values)
+        seen_ = sorted(visible)
+        context = None
+        if self.rules.scopes or self.rules.values:
+            scopes = FileScopes(facts, self.rules.scopes, seen_, tracer.read)
+            imports = imported_names(facts.dependencies) if python else {}
+            c_family = facts.language in _C_FAMILY
+            aliases = TypeAliases(facts.bindings, facts.statements) if c_family else None
+            context = FileContext(scopes, imports, aliases)
+        return file_link_sites(facts, self.rules, seen_, tracer.read, modules, context)
 
 
 def _incoming(sites: Mapping[str, tuple[LinkSite, ...]]) -> dict[str, list[LinkSite]]:

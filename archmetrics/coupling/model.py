@@ -25,6 +25,12 @@ class CouplingOptions:
     include_dirs: tuple[str, ...] = ()
     per_file: bool = False
     python_roots: tuple[str, ...] | None = None
+    group: str = "component"  # component | file | package | node (elements.py)
+
+    @property
+    def grouping(self) -> str:
+        """How files are grouped into elements: ``per_file`` is ``"file"``."""
+        return "file" if self.per_file else self.group
 
 
 class Resolution(StrEnum):
@@ -70,6 +76,8 @@ class Endpoint:
     key: str
     text: str  # as written, e.g. "tcp://*:5555" or PORT
     via: str = "argument"  # argument | constant | same-function | callee
+    # more keys the site receives on (a tf listener: topic:/tf and topic:/tf_static)
+    also: tuple[str, ...] = ()
 
 
 class LinkStatus(StrEnum):
@@ -94,6 +102,13 @@ class LinkSite:
     targets: tuple[str, ...] = ()  # elements this site links into
     function: str | None = None
     note: str = ""  # why the endpoint is unknown, when it is known why (several values ...)
+    # a graph name (ROS): the name as read, before it is resolved against its node
+    name: str = ""
+    # the node the site is made in, as the code names it (/ns/talker); of a launch file's
+    # entry: the node it starts
+    node: str = ""
+    data_type: str = ""  # the message, service or action type (geometry_msgs/msg/Twist)
+    parameter: str = ""  # the parameter whose default gave the name ("" if none)
 
 
 class EdgeKind(StrEnum):

@@ -45,8 +45,13 @@ class EndpointSource(StrEnum):
 
 ENDPOINT_TYPES = frozenset(
     {"address", "port", "topic", "service", "event", "operation", "library", "module",
-     "interface", "type", "property", "name", "ice"}
+     "interface", "type", "property", "name", "ice", "action", "plugin", "parameter", "node"}
 )  # fmt: skip
+NAMINGS = frozenset({"ros", "ros1"})  # how names resolve (coupling/rosnames.py)
+# configuration files read by code that knows their format's meaning (coupling/roslinks.py)
+INTERPRETERS = frozenset(
+    {"ros-parameters", "ros-launch", "pluginlib", "ros-package", "ros-interface"}
+)
 KNOWN_LANGUAGES = frozenset(str(lang) for lang in Language)
 
 
@@ -76,6 +81,20 @@ class FunctionHint:
 
 
 @dataclass(frozen=True, slots=True)
+class Place:
+    """Where a value is at a call: a template argument of the callee (C++), a positional
+    argument, a keyword argument (tried first), or a fixed ``value``; ``callback`` (C++, a
+    data type): else the type of the first parameter of the file's function the positional
+    argument at that index names (ROS 1's ``nh.subscribe("scan", 10, onScan)``)."""
+
+    template: int | None = None
+    arg: int | None = None
+    keyword: str | None = None
+    value: str | None = None
+    callback: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class EndpointSpec:
     """Where a site's endpoint literal is and how to normalize it (``type``)."""
 
@@ -86,6 +105,55 @@ class EndpointSpec:
     pattern: str | None = None  # regex; group 1 (or the whole match) is the endpoint
     same_function: tuple[FunctionHint, ...] = ()
     same_file: bool = False  # else: the one endpoint the file's other sites of the pack agree on
+    # the name is fixed (a tf broadcaster's ``/tf``); more than one: the site receives all
+    value: tuple[str, ...] = ()
+    # a call on an object made by a call matching one of these (``pub_->publish(m)`` after
+    # ``pub_ = create_publisher<T>("x", 10)``) takes that call's endpoint and data type
+    created_by: tuple[str, ...] = ()
+    naming: str | None = None  # "ros"/"ros1": a graph name, resolved against its node
+    data_type: Place | None = None  # where the message, service or action type is
+    # with created_by: a call on an object no call of the file made is no link (``call``)
+    created_only: bool = False
+    # positions tried after ``arg`` when it gives nothing (an overload with more arguments:
+    # rclcpp_action::create_client(base, graph, logging, waitables, name))
+    more_args: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class ScopeRule:
+    """Calls that say what names resolve against (``kind``): ``node`` -- a node's name and
+    namespace (``Node("talker")``, ``rospy.init_node("talker")``), for the calls of its
+    class, of the object it makes, or of its file; ``handle`` -- a ROS 1 NodeHandle's
+    namespace (``ros::NodeHandle pnh("~")``), for the calls on the object it makes."""
+
+    pack: str
+    id: str
+    languages: tuple[str, ...]
+    match: tuple[str, ...]
+    kind: str
+    name: Place | None = None
+    namespace: Place | None = None
+    requires: tuple[str, ...] = ()
+    description: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class ValueRule:
+    """Calls whose value is known statically although it is no literal: a parameter read
+    with its default (``declare_parameter("topic", "cmd_vel")``: ``value`` is the default,
+    ``name`` the parameter's name, so that a later ``get_parameter("topic")`` reads the same
+    value), a wrapper (``rclcpp::ParameterValue("x")``), or a call that writes the value
+    into one of its arguments (``out``: ``get_parameter("topic", topic_)``)."""
+
+    pack: str
+    id: str
+    languages: tuple[str, ...]
+    match: tuple[str, ...]
+    value: Place | None = None
+    name: Place | None = None
+    out: int | None = None
+    requires: tuple[str, ...] = ()
+    description: str = ""
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,6 +215,12 @@ class ConfigRule:
     description: str = ""
     example: str = ""  # a configuration file in ``format`` holding one such link
     example_endpoint: str | None = None
+    # the links are read by code that knows the file's meaning (a launch file, a parameter
+    # file, a plugin description; INTERPRETERS) instead of ``table`` and ``endpoint.key``
+    interpret: str | None = None
+    # the files are configuration only inside a folder holding this file (``package.xml``:
+    # a ROS package), so a tree without it reads none of them
+    within: str | None = None
 
     @property
     def qualified_id(self) -> str:
@@ -161,6 +235,8 @@ class RulePack:
     rules: tuple[Rule, ...]
     configuration: tuple[ConfigRule, ...] = ()
     digest: str = ""  # SHA-256 of the text it was read from ("": made in memory)
+    scopes: tuple[ScopeRule, ...] = ()
+    values: tuple[ValueRule, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -180,3 +256,13 @@ class RuleSet:
     def configuration(self) -> tuple[ConfigRule, ...]:
         """The configuration-link rules of every pack, in load order."""
         return tuple(rule for pack in self.packs for rule in pack.configuration)
+
+    @property
+    def scopes(self) -> tuple[ScopeRule, ...]:
+        """The naming-scope rules of every pack, in load order."""
+        return tuple(rule for pack in self.packs for rule in pack.scopes)
+
+    @property
+    def values(self) -> tuple[ValueRule, ...]:
+        """The value rules of every pack, in load order."""
+        return tuple(rule for pack in self.packs for rule in pack.values)

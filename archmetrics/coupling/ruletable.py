@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from archmetrics.coupling.rules import ConfigRule, EndpointSource, EndpointSpec, Rule, RuleSet
+from archmetrics.coupling.rules import (
+    ConfigRule,
+    EndpointSource,
+    EndpointSpec,
+    Place,
+    Rule,
+    RulePack,
+    RuleSet,
+)
 from archmetrics.markup import code_span, table_cell
 
 
@@ -31,7 +39,8 @@ def describe_endpoint(spec: EndpointSpec | None) -> str:
         return f"{spec.type}: callee ~ {spec.pattern}"
     places = []
     if spec.arg is not None:
-        places.append(f"arg {spec.arg}")
+        more = "".join(f" or {index}" for index in spec.more_args)
+        places.append(f"arg {spec.arg}{more}")
     if spec.keyword is not None:
         places.append(f"{spec.keyword}=")
     if spec.pattern is not None:
@@ -44,6 +53,15 @@ def describe_endpoint(spec: EndpointSpec | None) -> str:
         places.append(f"{'else ' if places else ''}same function: {hints}")
     if spec.same_file:
         places.append(f"{'else ' if places else ''}same file")
+    if spec.created_by:
+        only = " only" if spec.created_only else ""
+        places.append(f"{'else ' if places else ''}made by{only}: {', '.join(spec.created_by)}")
+    if spec.value:
+        places.append(f"{'else ' if places else ''}{', '.join(spec.value)}")
+    if spec.naming:
+        places.append(f"{spec.naming} name")
+    if spec.data_type is not None:
+        places.append(f"type {_place(spec.data_type)}")
     return f"{spec.type}: {' / '.join(places)}" if places else spec.type
 
 
@@ -69,8 +87,11 @@ def config_row(rule: ConfigRule) -> RuleRow:
     when = "; ".join(f"{key} = {' | '.join(values)}" for key, values in rule.when)
     defaults = ", ".join(f"{key} = {value}" for key, value in rule.defaults)
     match = f"{', '.join(rule.files)}: [{'.'.join(rule.table)}]"
+    if rule.interpret:
+        match = f"{', '.join(rule.files)}: read as {rule.interpret}"
     match += f" where {when}" if when else ""
     match += f" (default {defaults})" if defaults else ""
+    match += f" (in a tree with {rule.within})" if rule.within else ""
     pattern = f" ~ {rule.endpoint.pattern}" if rule.endpoint.pattern else ""
     return RuleRow(
         pack=rule.pack,
@@ -79,7 +100,9 @@ def config_row(rule: ConfigRule) -> RuleRow:
         match=match,
         kind=rule.kind.value,
         role=rule.role.value,
-        endpoint=f"{rule.endpoint.type}: key {rule.endpoint.key}{pattern}",
+        endpoint=f"{rule.endpoint.type}: key {rule.endpoint.key}{pattern}"
+        if rule.endpoint.key
+        else rule.endpoint.type,
     )
 
 
@@ -112,4 +135,34 @@ def rules_markdown(rules: RuleSet, heading: str = "###") -> str:
                      row.requires)  # fmt: skip
             lines.append("| " + " | ".join(_code(c) for c in cells) + " |")
         lines.append("")
+        lines += _names_and_values(pack)
     return "\n".join(lines)
+
+
+def _place(place: Place | None) -> str:
+    if place is None:
+        return "-"
+    parts = [
+        f"template {place.template}" if place.template is not None else "",
+        f"arg {place.arg}" if place.arg is not None else "",
+        f"{place.keyword}=" if place.keyword else "",
+        f"{place.value!r}" if place.value is not None else "",
+        f"else callback arg {place.callback}" if place.callback is not None else "",
+    ]
+    return " / ".join(p for p in parts if p)
+
+
+def _names_and_values(pack: RulePack) -> list[str]:
+    """A pack's ``[[scopes]]`` and ``[[values]]``, a line each (they find no sites)."""
+    lines = [
+        f"- scope {code_span(s.id)} ({s.kind}, {', '.join(s.languages)}): "
+        f"{code_span(', '.join(s.match))}, name {_place(s.name)}, namespace {_place(s.namespace)}"
+        for s in pack.scopes
+    ]
+    lines += [
+        f"- value {code_span(v.id)} ({', '.join(v.languages)}): "
+        f"{code_span(', '.join(v.match))}, value {_place(v.value)}, parameter {_place(v.name)}"
+        + (f", written into arg {v.out}" if v.out is not None else "")
+        for v in pack.values
+    ]
+    return [*lines, ""] if lines else []

@@ -22,7 +22,7 @@ from typing import Any, Protocol
 from archmetrics.coupling.model import Endpoint, LinkSite, LinkStatus
 from archmetrics.coupling.rules import LinkKind, Role
 
-RECORD = "link-sites/1"
+RECORD = "link-sites/2"
 
 
 class SiteStore(Protocol):
@@ -75,10 +75,14 @@ def encode_sites(path: str, sites: Sequence[LinkSite]) -> bytes | None:
     for s in sites:
         if s.path != path or s.status is not LinkStatus.UNRESOLVED or s.targets:
             return None
-        endpoint = None if s.endpoint is None else [s.endpoint.key, s.endpoint.text, s.endpoint.via]
+        endpoint = None
+        if s.endpoint is not None:
+            point = s.endpoint
+            endpoint = [point.key, point.text, point.via, list(point.also)]
         rows.append(
-            [s.line, s.rule, s.kind.value, s.role.value, s.callee, endpoint, s.function, s.note]
-        )
+            [s.line, s.rule, s.kind.value, s.role.value, s.callee, endpoint, s.function, s.note,
+             s.name, s.node, s.data_type, s.parameter]
+        )  # fmt: skip
     return json.dumps(rows, separators=(",", ":")).encode()  # ASCII: any text survives
 
 
@@ -100,13 +104,13 @@ def decode_sites(path: str, data: bytes) -> tuple[LinkSite, ...] | None:
 
 
 def _site(path: str, row: object) -> LinkSite | None:
-    if not (isinstance(row, list) and len(row) == 8):
+    if not (isinstance(row, list) and len(row) == 12):
         return None
-    line, rule, kind, role, callee, endpoint, function, note = row
+    line, rule, kind, role, callee, endpoint, function, note, *names = row
     if not (
         type(line) is int
         and line >= 0
-        and all(isinstance(t, str) for t in (rule, kind, role, callee, note))
+        and all(isinstance(t, str) for t in (rule, kind, role, callee, note, *names))
         and (function is None or isinstance(function, str))
         and kind in _KINDS
         and role in _ROLES
@@ -116,14 +120,18 @@ def _site(path: str, row: object) -> LinkSite | None:
     if endpoint is not None:
         if not (
             isinstance(endpoint, list)
-            and len(endpoint) == 3
-            and all(isinstance(t, str) for t in endpoint)
+            and len(endpoint) == 4
+            and all(isinstance(t, str) for t in endpoint[:3])
+            and isinstance(endpoint[3], list)
+            and all(isinstance(t, str) for t in endpoint[3])
         ):
             return None
-        point = Endpoint(*endpoint)
+        key, text, via, also = endpoint
+        point = Endpoint(key, text, via, tuple(also))
+    name, node, data_type, parameter = names
     return LinkSite(
         path, line, rule, LinkKind(kind), Role(role), callee, point, LinkStatus.UNRESOLVED,
-        (), function, note,
+        (), function, note, name, node, data_type, parameter,
     )  # fmt: skip
 
 

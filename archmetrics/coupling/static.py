@@ -13,9 +13,12 @@ from dataclasses import dataclass
 
 from archmetrics.coupling.elements import Element
 from archmetrics.coupling.imports import ModuleIndex
-from archmetrics.coupling.includes import IncludeIndex, normalize
+from archmetrics.coupling.includes import IncludeIndex, IncludeResolution, normalize
+from archmetrics.coupling.interfaces import InterfaceIndex
 from archmetrics.coupling.model import CouplingOptions, Resolution, SourceRef, StaticDependency
 from archmetrics.facts import Dependency, DependencyKind, FileFacts
+
+_GENERATED = "generated from an interface file of the tree"
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,6 +40,14 @@ class StaticResolver:
         self.options, self.paths = options, paths
         self._includes: IncludeIndex | None = None
         self._modules: ModuleIndex | None = None
+        self._interfaces: InterfaceIndex | None = None
+
+    @property
+    def interfaces(self) -> InterfaceIndex:
+        """The tree's ROS interface files (when a dependency first is not in the tree)."""
+        if self._interfaces is None:
+            self._interfaces = InterfaceIndex(self.paths)
+        return self._interfaces
 
     @property
     def includes(self) -> IncludeIndex:
@@ -70,13 +81,36 @@ class StaticResolver:
             site = SourceRef(facts.path, dep.span.start)
             if dep.kind is DependencyKind.IMPORT:
                 for imp in self.modules.resolve(facts.path, dep):
+                    if (
+                        imp.resolution is not Resolution.INTERNAL
+                        and dep.names
+                        and (found_in := self._interface_imports(dep, site))
+                    ):
+                        found.extend(found_in)  # from geometry_msgs.msg import Twist
+                        continue
                     found.append(Occurrence(imp.name, dep.kind, imp.resolution, site,
                                             imp.target_file, imp.note))  # fmt: skip
             else:
                 inc = self.includes.resolve(facts.path, dep.target, dep.kind)
+                if inc.resolution is not Resolution.INTERNAL and (
+                    defined := self.interfaces.include(dep.target)
+                ):
+                    inc = IncludeResolution(Resolution.INTERNAL, defined, _GENERATED)
                 found.append(Occurrence(dep.target, dep.kind, inc.resolution, site,
                                         inc.target_file, inc.note))  # fmt: skip
         return tuple(found)
+
+    def _interface_imports(self, dep: Dependency, site: SourceRef) -> list[Occurrence]:
+        """``from pkg.msg import A, B``: a dependency on each interface file the tree holds
+        (none unless it holds all of them, so a name is never dropped)."""
+        files = [self.interfaces.module(dep.target, name) for name in dep.names]
+        if not self.interfaces or not all(files):
+            return []
+        return [
+            Occurrence(f"{dep.target}.{name}", dep.kind, Resolution.INTERNAL, site, file,
+                       _GENERATED)
+            for name, file in zip(dep.names, files, strict=True)
+        ]  # fmt: skip
 
 
 def element_dependencies(

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from archmetrics.coupling.dynamic import normalize_callee
 from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
     KNOWN_LANGUAGES,
+    NAMINGS,
     EndpointSource,
     EndpointSpec,
     FunctionHint,
@@ -20,9 +20,8 @@ from archmetrics.coupling.rules import (
     SiteKind,
 )
 from archmetrics.coupling.validate_where import ID as _ID
-from archmetrics.coupling.validate_where import Where, rule_header
+from archmetrics.coupling.validate_where import Where, check_glob, parse_place, rule_header
 from archmetrics.coupling.validate_where import list_of as _list
-from archmetrics.globs import BadPattern, compile_glob
 
 _PACK_KEYS = frozenset({"name", "description"})
 _RULE_KEYS = frozenset(
@@ -30,17 +29,19 @@ _RULE_KEYS = frozenset(
      "description", "example", "example_endpoint", "unless_from"}
 )  # fmt: skip
 _ENDPOINT_KEYS = frozenset(
-    {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file"}
-)
+    {"type", "arg", "keyword", "from", "pattern", "same_function", "same_file", "value",
+     "created_by", "naming", "data_type", "created_only"}
+)  # fmt: skip
 _HINT_KEYS = frozenset({"match", "arg", "keyword"})
 
 
 def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
     """Validate one decoded TOML document and build its :class:`RulePack`."""
     from archmetrics.coupling.validate_config import parse_configuration
+    from archmetrics.coupling.validate_scopes import parse_scopes, parse_values
 
     top = Where(source)
-    top.table(data, "", frozenset({"pack", "rules", "configuration"}))
+    top.table(data, "", frozenset({"pack", "rules", "configuration", "scopes", "values"}))
     pack = top.table(data.get("pack"), "pack", _PACK_KEYS)
     name = top.text(pack, "name")
     if not _ID.match(name):
@@ -50,12 +51,15 @@ def parse_pack(data: Mapping[str, object], source: str) -> RulePack:
         top.fail("rules", "a pack needs a non-empty [[rules]] or [[configuration]] array")
     rules = tuple(_parse_rule(raw, name, source, index) for index, raw in enumerate(raw_rules))
     configuration = parse_configuration(data.get("configuration", []), name, source)
+    scopes = parse_scopes(data.get("scopes", []), name, source)
+    values = parse_values(data.get("values", []), name, source)
     seen: set[str] = set()
-    for ident in [r.id for r in rules] + [r.id for r in configuration]:
+    for ident in [r.id for group in (rules, configuration, scopes, values) for r in group]:
         if ident in seen:
             Where(source, ident).fail("id", "duplicate rule id in this pack")
         seen.add(ident)
-    return RulePack(name, source, top.text(pack, "description", ""), rules, configuration)
+    description = top.text(pack, "description", "")
+    return RulePack(name, source, description, rules, configuration, "", scopes, values)
 
 
 def _parse_rule(raw: object, pack: str, source: str, index: int) -> Rule:
@@ -101,18 +105,8 @@ def _examples(where: Where, raw: object, languages: tuple[str, ...]) -> tuple[tu
 def _patterns(where: Where, table: Mapping[str, object]) -> tuple[str, ...]:
     patterns = where.texts(table, "match", required=True)
     for pattern in patterns:
-        _check_glob(where, "match", pattern)
+        check_glob(where, "match", pattern)
     return patterns
-
-
-def _check_glob(where: Where, key: str, pattern: str) -> None:
-    """A ``match`` pattern: a dotted callee name with globs of the one dialect (globs.py)."""
-    if any(c.isspace() for c in pattern) or "(" in pattern or "/" in pattern:
-        where.fail(key, f"{pattern!r}: a pattern is a dotted callee name with * globs")
-    try:
-        compile_glob(normalize_callee(pattern))
-    except BadPattern as error:
-        where.fail(key, str(error))
 
 
 def _parse_endpoint(where: Where, raw: object) -> EndpointSpec:
@@ -144,6 +138,23 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
     same_file = table.get("same_file", False)
     if not isinstance(same_file, bool):
         where.fail("same_file", "must be true or false")
+    created_by = where.texts(table, "created_by", required=False)
+    for match in created_by:
+        check_glob(where, "created_by", match)
+    naming = table.get("naming")
+    if naming is not None and naming not in NAMINGS:
+        where.fail("naming", f"{naming!r} is not one of {_list(NAMINGS)}")
+    data_type = table.get("data_type")
+    raw_arg = table.get("arg")
+    more_args: tuple[int, ...] = ()
+    if isinstance(raw_arg, list):
+        if not raw_arg or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 0
+                                  for a in raw_arg):  # fmt: skip
+            where.fail("arg", "a list of argument indexes must hold integers >= 0")
+        more_args = tuple(raw_arg[1:])
+    created_only = table.get("created_only", False)
+    if not isinstance(created_only, bool) or (created_only and not created_by):
+        where.fail("created_only", "must be true or false, and true only with created_by")
     return EndpointSpec(
         type=where.choice(table, "type", ENDPOINT_TYPES),
         arg=where.integer(table, "arg"),
@@ -152,6 +163,12 @@ def _endpoint_fields(where: Where, table: Mapping[str, object]) -> EndpointSpec:
         pattern=pattern,
         same_function=tuple(_parse_hint(where, hint) for hint in hints),
         same_file=same_file,
+        value=where.texts(table, "value", required=False),
+        created_by=created_by,
+        naming=naming if isinstance(naming, str) else None,
+        data_type=None if data_type is None else parse_place(where, data_type, "data_type"),
+        created_only=created_only,
+        more_args=more_args,
     )
 
 
@@ -165,5 +182,5 @@ def _parse_hint(where: Where, raw: object) -> FunctionHint:
         raise RulePackError(error.source, error.rule, key, error.problem) from None
     if arg is None and keyword is None:
         where.fail("endpoint.same_function", "a hint needs arg or keyword")
-    _check_glob(where, "endpoint.same_function.match", match)
+    check_glob(where, "endpoint.same_function.match", match)
     return FunctionHint(match, arg, keyword)

@@ -9,6 +9,7 @@ from collections.abc import Mapping
 from archmetrics.coupling.patterns import PatternError, compile_pattern
 from archmetrics.coupling.rules import (
     ENDPOINT_TYPES,
+    INTERPRETERS,
     ConfigEndpoint,
     ConfigRule,
     LinkKind,
@@ -20,7 +21,7 @@ from archmetrics.facts import ConfigFormat
 
 _KEYS = frozenset(
     {"id", "files", "format", "table", "when", "defaults", "kind", "role", "endpoint",
-     "description", "example", "example_endpoint"}
+     "description", "example", "example_endpoint", "interpret", "within"}
 )  # fmt: skip
 _ENDPOINT_KEYS = frozenset({"type", "key", "pattern"})
 _FORMATS = frozenset(str(f) for f in ConfigFormat)
@@ -40,8 +41,11 @@ def _rule(raw: object, pack: str, source: str, index: int) -> ConfigRule:
     for glob in files:
         if glob.startswith("!") or not glob.strip("/"):
             where.fail("files", f"{glob!r}: a glob may not be empty, '/' or a '!' negation")
-    selector = where.text(table, "table")
-    if not _TABLE.match(selector):
+    interpret = table.get("interpret")
+    if interpret is not None and interpret not in INTERPRETERS:
+        where.fail("interpret", f"{interpret!r} is not one of {', '.join(sorted(INTERPRETERS))}")
+    selector = where.text(table, "table", "" if interpret else None)
+    if selector and not _TABLE.match(selector):
         where.fail("table", f"{selector!r} must be bare keys joined by dots (rules.to)")
     example_endpoint = table.get("example_endpoint")
     if example_endpoint is not None and not isinstance(example_endpoint, str):
@@ -51,23 +55,34 @@ def _rule(raw: object, pack: str, source: str, index: int) -> ConfigRule:
         id=ident,
         files=files,
         format=where.choice(table, "format", _FORMATS),
-        table=tuple(selector.split(".")),
+        table=tuple(selector.split(".")) if selector else (),
         kind=LinkKind(where.choice(table, "kind", frozenset(LinkKind))),
         role=Role(where.choice(table, "role", frozenset(Role))),
-        endpoint=_endpoint(where, table.get("endpoint")),
+        endpoint=_endpoint(where, table.get("endpoint"), bool(interpret)),
         when=_when(where, table.get("when", {})),
         defaults=_defaults(where, table.get("defaults", {})),
         description=where.text(table, "description", ""),
         example=where.text(table, "example", ""),
         example_endpoint=example_endpoint,
+        interpret=interpret if isinstance(interpret, str) else None,
+        within=_within(where, table.get("within")),
     )
 
 
-def _endpoint(where: Where, raw: object) -> ConfigEndpoint:
+def _within(where: Where, raw: object) -> str | None:
+    """``within = "package.xml"``: a file name (no folder, no glob)."""
+    if raw is None:
+        return None
+    if not isinstance(raw, str) or not raw or any(c in raw for c in "/*?[\\"):
+        where.fail("within", "must be a file name, as package.xml")
+    return raw
+
+
+def _endpoint(where: Where, raw: object, interpreted: bool) -> ConfigEndpoint:
     table = where.table(raw, "endpoint", _ENDPOINT_KEYS)
     try:
         kind = where.choice(table, "type", ENDPOINT_TYPES)
-        key = where.text(table, "key")
+        key = where.text(table, "key", "" if interpreted else None)
         pattern = where.text(table, "pattern", "") or None
     except RulePackError as error:
         key = f"endpoint.{error.key}"

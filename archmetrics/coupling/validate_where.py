@@ -8,7 +8,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import NoReturn
 
-from archmetrics.coupling.rules import RulePackError
+from archmetrics.coupling.matching import normalize_callee
+from archmetrics.coupling.rules import Place, RulePackError
+from archmetrics.globs import BadPattern, compile_glob
 
 ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 
@@ -47,6 +49,8 @@ class Where:
 
     def integer(self, table: Mapping[str, object], key: str) -> int | None:
         value = table.get(key)
+        if key == "arg" and isinstance(value, list) and value:  # [1, 4]: 1, else 4
+            value = value[0]
         if value is not None and (not isinstance(value, int) or isinstance(value, bool)):
             self.fail(key, f"must be an integer, got {value!r}")
         if isinstance(value, int) and key == "arg" and value < 0:
@@ -77,3 +81,38 @@ def rule_header(
     if not ID.match(ident):
         where.fail("id", f"{ident!r} must be letters, digits and _.+-")
     return where, table, ident
+
+
+_PLACE_KEYS = frozenset({"template", "arg", "keyword", "value", "callback"})
+
+
+def check_glob(where: Where, key: str, pattern: str) -> None:
+    """A ``match`` pattern: a dotted callee name with globs of the one dialect (globs.py)."""
+    if any(c.isspace() for c in pattern) or "(" in pattern or "/" in pattern:
+        where.fail(key, f"{pattern!r}: a pattern is a dotted callee name with * globs")
+    try:
+        compile_glob(normalize_callee(pattern))
+    except BadPattern as error:
+        where.fail(key, str(error))
+
+
+def parse_place(where: Where, raw: object, key: str) -> Place:
+    """``{ template = 0 }``, ``{ arg = 1, keyword = "name" }`` or ``{ value = "~" }``."""
+    table = where.table(raw, key, _PLACE_KEYS)
+    try:
+        place = Place(
+            template=where.integer(table, "template"),
+            arg=where.integer(table, "arg"),
+            keyword=where.text(table, "keyword", "") or None,
+            value=where.text(table, "value", "") or None,
+            callback=where.integer(table, "callback"),
+        )
+    except RulePackError as error:
+        raise RulePackError(error.source, error.rule, f"{key}.{error.key}", error.problem) from None
+    if place == Place():
+        where.fail(key, "says nowhere: give template, arg, keyword or value")
+    if place.template is not None and place.template < 0:
+        where.fail(f"{key}.template", "template argument index must be >= 0")
+    if place.callback is not None and place.callback < 0:
+        where.fail(f"{key}.callback", "argument index must be >= 0")
+    return place

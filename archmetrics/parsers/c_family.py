@@ -245,14 +245,17 @@ def _parse(
     reading = Reading.of(built, first, limits, damage_only=True)
     if isinstance(reading, str):
         return not_measured(path, str(language), 1, reading)
-    if reading.root.has_error:
+    damaged = reading.root.has_error  # (a macro called without its `;` is damage)
+    if damaged:
         reading = _recover(built, reading, limits)
         if isinstance(reading, str):
             return not_measured(path, str(language), 1, reading)
     composite = _branches(built, reading, limits) if reading.root.has_error else None
     reading_used = composite or Composite(reading.root, reading.found, reading.standalone())
     reading_used.hidden_comments = hidden
-    return facts(path, language, built, reading_used, data, limits.c_macros, second_reading)
+    return facts(
+        path, language, built, reading_used, data, limits.c_macros, second_reading, damaged
+    )
 
 
 def _recover(built: Grammar, reading: Reading, limits: ParseLimits) -> Reading | str:

@@ -1,14 +1,18 @@
 """C and C++ bindings (facts.Binding): what names are given which values, as written.
 
-Three shapes, captured by the query (``@bind``): an object-like macro with a body
+Four shapes, captured by the query (``@bind``): an object-like macro with a body
 (``#define PORT "3490"``), an initialized declarator with ``=`` (``const char *port =
 getenv("P")``, every declarator of ``int a = 1, b = 2;``, at any scope, a class member's
 ``static constexpr int P = 7;`` too) and a plain
 assignment to a name (``fd = socket(...)``, also inside a condition:
-``if ((fd = open(p)) < 0)``). The declared name is found through pointer, array, reference
+``if ((fd = open(p)) < 0)``) or to a member of ``this`` (``this->topic_ = "x"``, named
+``this->topic_``). The declared name is found through pointer, array, reference
 and parenthesized declarators; brace and constructor initializers (``int x{5}``,
-``std::string s("x")``) and compound assignments (``+=``) bind nothing. The value's text is
-normalized as statement texts are.
+``std::string s("x")``) and compound assignments (``+=``) bind nothing. And a C++ type
+alias, at any scope: ``using Msg = std_msgs::msg::String;``, ``using std_msgs::msg::Int32;``
+(``Int32`` bound to ``std_msgs::msg::Int32``) and a ``typedef`` of one plain name (``typedef
+a::B C;``); ``using namespace`` binds nothing. The value's text is normalized as statement
+texts are.
 """
 
 from __future__ import annotations
@@ -26,6 +30,8 @@ _WRAPPERS = frozenset(
 )
 _NOT_ASSIGNED = frozenset({"argument_list", "initializer_list"})
 _NAMES = frozenset({"identifier", "field_identifier"})
+_ASSIGNED = frozenset({"identifier", "field_expression"})  # x = ..., this->x = ...
+_ONE_TOKEN = _NAMES | {"type_identifier"}
 
 
 def _declared(declarator: Node | None) -> Node | None:
@@ -43,6 +49,25 @@ def _declared(declarator: Node | None) -> Node | None:
 def _parts(node: Node) -> tuple[Node | None, Node | None]:
     """(name, value) of one captured node, or Nones when it binds no plain name."""
     kind = node.type
+    if kind == "alias_declaration":  # using Msg = std_msgs::msg::String;
+        return node.child_by_field_name("name"), node.child_by_field_name("type")
+    if kind == "type_definition":  # typedef a::B C;
+        declarator = node.child_by_field_name("declarator")
+        if declarator is None or declarator.type != "type_identifier":
+            return None, None
+        return declarator, node.child_by_field_name("type")
+    if kind == "using_declaration":  # using std_msgs::msg::Int32;
+        used = node.named_child(0)
+        if (
+            used is None
+            or used.type != "qualified_identifier"
+            or any(not child.is_named and child.type == "namespace" for child in node.children)
+        ):
+            return None, None
+        name: Node | None = used
+        while name is not None and name.type == "qualified_identifier":
+            name = name.child_by_field_name("name")
+        return (name if name is not None and name.type in _ONE_TOKEN else None), used
     if kind == "preproc_def":
         return node.child_by_field_name("name"), node.child_by_field_name("value")
     if kind == "init_declarator" or kind == "field_declaration":
@@ -54,7 +79,11 @@ def _parts(node: Node) -> tuple[Node | None, Node | None]:
     if operator is None or operator.type != "=":
         return None, None
     left = node.child_by_field_name("left")
-    return (left if left is not None and left.type == "identifier" else None), (
+    if left is not None and left.type == "field_expression":  # this->x = value
+        argument = left.child_by_field_name("argument")
+        if argument is None or argument.type != "this":
+            left = None
+    return (left if left is not None and left.type in _ASSIGNED else None), (
         node.child_by_field_name("right")
     )
 
@@ -73,7 +102,7 @@ def bindings(
             continue
         written = clean[name.start_byte : name.end_byte]
         # an identifier is one token: its compact form is its bytes
-        text = written.decode("utf-8", "replace") if name.type in _NAMES else compact(written)
+        text = written.decode("utf-8", "replace") if name.type in _ONE_TOKEN else compact(written)
         found.append((text, node.start_point.row + 1))
         starts.append(node.start_byte)
         values.append(clean[value.start_byte : value.end_byte])

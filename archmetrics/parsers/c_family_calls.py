@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import bisect
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from tree_sitter import Node
 
@@ -17,6 +17,10 @@ from archmetrics.parsers import shown
 from archmetrics.parsers.c_family_names import in_order, text
 from archmetrics.parsers.c_family_text import compact, literal, normal, string_value
 from archmetrics.parsers.text import collapse
+
+Construction = tuple[Node, str, Node, str | None]
+"""A constructor call without a call expression: where, the class as written (compact), the
+argument list (or braces) and the target (c_family_constructs.py)."""
 
 _STRINGS = frozenset({"string_literal", "raw_string_literal"})
 _CALLEE = re.compile(r"(.*)(\.|->|::)(~?[A-Za-z_$][\w$]*)\Z", re.DOTALL)
@@ -46,6 +50,43 @@ def without_template_arguments(written: str) -> str:
     return "".join(kept)
 
 
+def template_arguments(written: str) -> tuple[str, ...]:
+    """The template arguments of the last part of a callee written ``written`` (compact),
+    split at their top-level commas: ``a->f<T, std::map<K, V>>`` gives ``("T",
+    "std::map<K,V>")``; none when it does not end in ``>`` (``operator>`` neither)."""
+    if not written.endswith(">"):
+        return ()
+    depth = 0
+    for at in range(len(written) - 1, -1, -1):
+        char = written[at]
+        if char == ">":
+            depth += 1
+        elif char == "<":
+            depth -= 1
+            if depth == 0:
+                return split_top_level(written[at + 1 : -1])
+        elif char in "()" and depth == 1:
+            return ()  # `operator()<...>`? a comparison? not a template argument list
+    return ()
+
+
+def split_top_level(text: str) -> tuple[str, ...]:
+    """``text`` split at the commas outside brackets, each part stripped (empty parts
+    left out)."""
+    parts: list[str] = []
+    depth, start = 0, 0
+    for at, char in enumerate(text):
+        if char in "<([{":
+            depth += 1
+        elif char in ">)]}":
+            depth -= 1
+        elif char == "," and depth == 0:
+            parts.append(text[start:at].strip())
+            start = at + 1
+    parts.append(text[start:].strip())
+    return tuple(part for part in parts if part)
+
+
 _WINDOW = shown.LIMIT + 256  # bytes first read of a text to be cut
 _MARGIN = 16  # characters past the cut that a window's last, partial token may spoil
 _TAIL = 256  # bytes at the end of a cut callee read for its name
@@ -54,9 +95,12 @@ _TAIL = 256  # bytes at the end of a cut callee read for its name
 class CallSites:
     """The call sites of one file, texts cut where long calls nest (shown.py)."""
 
-    def __init__(self, nodes: list[Node], data: bytes) -> None:
+    def __init__(
+        self, nodes: list[Node], data: bytes, targets: dict[tuple[int, int], str] | None = None
+    ) -> None:
         self._nodes = in_order(nodes)
         self._data = data
+        self._targets = targets or {}  # a call's byte range -> what its value is assigned to
         # where each long call's argument list starts (none in most files: then no text
         # is checked for one)
         lists = (
@@ -69,15 +113,81 @@ class CallSites:
         # read for them: the calls of a chain share one
         self._cut: dict[tuple[int, Callable[[bytes], str]], tuple[int, str]] = {}
 
-    def sites(self, owners: Callable[[list[int]], list[str | None]]) -> tuple[CallSite, ...]:
-        """Every call site in order; ``owners`` names the function around each offset."""
+    def sites(
+        self,
+        owners: Callable[[list[int]], list[str | None]],
+        constructed: Sequence[Construction] = (),
+        macros: Sequence[tuple[int, int, int]] = (),
+    ) -> tuple[CallSite, ...]:
+        """Every call site in order; ``owners`` names the function around each offset.
+        ``constructed``: constructor calls written without a call expression
+        (c_family_constructs.py), each (where, class as written, arguments, target);
+        ``macros``: macro calls alone on their line (c_family_macros.macro_calls), kept
+        where they stand outside any function."""
         nodes = self._nodes
         functions = owners([node.start_byte for node in nodes])
-        return tuple(map(self._site, nodes, functions))
+        calls = tuple(map(self._site, nodes, functions))
+        if not constructed and not macros:
+            return calls
+        places = owners([where.start_byte for where, _, _, _ in constructed])
+        keyed = [((n.start_byte, -n.end_byte), c) for n, c in zip(nodes, calls, strict=True)]
+        keyed += [
+            ((parts[0].start_byte, -parts[0].end_byte), self._constructed(*parts, function))
+            for parts, function in zip(constructed, places, strict=True)
+        ]
+        read = {(c.span.start, c.callee) for c in calls} if macros else set()
+        keyed += [
+            ((start, 0), site) for start, site in self.macro_sites(macros, owners)
+            if site.function is None and (site.span.start, site.callee) not in read
+        ]  # fmt: skip
+        keyed.sort(key=lambda pair: pair[0])
+        return tuple(site for _, site in keyed)
+
+    def macro_sites(
+        self, found: Sequence[tuple[int, int, int]], owners: Callable[[list[int]], list[str | None]]
+    ) -> list[tuple[int, CallSite]]:
+        """Call sites of macros called alone on their line between declarations (``found``:
+        where each name, argument list and its end are, c_family_macros.macro_calls), each
+        with the byte it starts at."""
+        data = self._data
+        made = []
+        for (start, open_, close), function in zip(
+            found, owners([s for s, _, _ in found]), strict=True
+        ):
+            name = data[start:open_].decode("utf-8", "replace").strip()
+            inner = compact(data[open_ + 1 : close - 1]) if close - open_ > 2 else ""
+            arguments = tuple(_macro_argument(part) for part in split_top_level(inner))
+            first = data.count(b"\n", 0, start) + 1
+            last = first + data.count(b"\n", start, close)
+            span = _new(Span, (first, last))
+            site = _new(CallSite, (name, name, None, span, arguments, function, (), None))
+            made.append((start, site))
+        return made
+
+    def _constructed(
+        self, where: Node, written: str, arguments: Node, target: str | None, function: str | None
+    ) -> CallSite:
+        """A constructor call of the class ``written``, with ``arguments``' children."""
+        templates: tuple[str, ...] = ()
+        called = written
+        if "<" in written:
+            templates = template_arguments(written)
+            called = without_template_arguments(written)
+        receiver, _, name = called.rpartition("::")
+        values = tuple(
+            [self._argument(child) for child in arguments.named_children if child.type != "comment"]
+        )
+        first = where.start_point.row + 1
+        end_point = where.end_point
+        last = end_point.row + 1 if end_point.column else max(end_point.row, first)
+        span = _new(Span, (first, last))
+        return _new(
+            CallSite, (called, name, receiver or None, span, values, function, templates, target)
+        )
 
     def _site(self, node: Node, function: str | None) -> CallSite:
         function_node = node.child_by_field_name("function")
-        called = self._callee(function_node)
+        called, templates = self._callee(function_node)
         receiver: str | None = None
         name = called
         if function_node is not None and function_node.type != "identifier":
@@ -104,18 +214,24 @@ class CallSites:
         end_point = node.end_point
         last = end_point.row + 1 if end_point.column else max(end_point.row, first)
         where = _new(Span, (first, last))
-        return _new(CallSite, (called, name, receiver or None, where, values, function))
+        target = self._targets.get((node.start_byte, node.end_byte))
+        return _new(
+            CallSite, (called, name, receiver or None, where, values, function, templates, target)
+        )
 
-    def _callee(self, node: Node | None) -> str:
-        """The called expression's text, template arguments dropped: `Ice::checkedCast`."""
+    def _callee(self, node: Node | None) -> tuple[str, tuple[str, ...]]:
+        """The called expression's text, template arguments dropped (`Ice::checkedCast`),
+        and the template arguments of its last part."""
         if node is None:
-            return ""
+            return "", ()
         if node.type == "identifier":
-            return self._data[node.start_byte : node.end_byte].decode("utf-8", "replace")
+            return self._data[node.start_byte : node.end_byte].decode("utf-8", "replace"), ()
         written = self._text(node.start_byte, node.end_byte, compact)
+        templates: tuple[str, ...] = ()
         if "<" in written and node.type != "parenthesized_expression":
+            templates = template_arguments(written)
             written = without_template_arguments(written)
-        return written
+        return written, templates
 
     def _argument(self, node: Node) -> Argument:
         start, end = node.start_byte, node.end_byte
@@ -170,6 +286,15 @@ class CallSites:
         opens = self._opens
         index = bisect.bisect_left(opens, start)
         return index < len(opens) and opens[index] < end
+
+
+def _macro_argument(text: str) -> Argument:
+    """A macro's argument as written (a string literal's value read)."""
+    if text.startswith('"') and text.endswith('"') and len(text) > 1:
+        value = string_value(text.encode("utf-8", "surrogatepass"))
+        if value is not None:
+            return _new(Argument, (text, value, True, None))
+    return _new(Argument, (text, None, False, None))
 
 
 def _argument_text(raw: bytes) -> str:

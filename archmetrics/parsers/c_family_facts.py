@@ -10,10 +10,16 @@ from dataclasses import dataclass, field
 
 from tree_sitter import Node
 
-from archmetrics.facts import Decision, FileFacts, Function, Language, ParseWarning
+from archmetrics.facts import CallSite, Decision, FileFacts, Function, Language, ParseWarning
 from archmetrics.parsers import c_family_tokens, c_tables
 from archmetrics.parsers.c_family_bindings import bindings
 from archmetrics.parsers.c_family_calls import CallSites
+from archmetrics.parsers.c_family_constructs import (
+    call_targets,
+    constructions,
+    field_types,
+    initialized_members,
+)
 from archmetrics.parsers.c_family_definitions import Definition, definitions
 from archmetrics.parsers.c_family_functions import (
     FunctionSlot,
@@ -23,7 +29,7 @@ from archmetrics.parsers.c_family_functions import (
 )
 from archmetrics.parsers.c_family_grammar import Grammar, missing_parents
 from archmetrics.parsers.c_family_heads import KEYWORDS
-from archmetrics.parsers.c_family_macros import MacroNames
+from archmetrics.parsers.c_family_macros import MacroNames, macro_calls
 from archmetrics.parsers.c_family_names import Scopes, in_order, typedef_names
 from archmetrics.parsers.c_family_outline import classes, includes
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements
@@ -54,10 +60,13 @@ def facts(
     data: bytes,
     macros: MacroNames,
     second_reading: bool = True,
+    damaged: bool = False,
 ) -> FileFacts:
     """The facts of ``reading``'s captures, with every text taken from ``data`` as written.
     ``second_reading``: where the tree cannot be trusted, compare it with the token
-    reading (False: the tree's facts alone, without warnings; a measuring aid)."""
+    reading (False: the tree's facts alone, without warnings; a measuring aid).
+    ``damaged``: the first parse had errors (then macros called alone on their line, which
+    a reading may have blanked, are call sites too)."""
     root, found = reading.root, reading.found
     typedefs = typedef_names(found.get("stmt", []), data)
     scopes = Scopes(found.get("namespace", []), found.get("class", []), data, typedefs)
@@ -95,7 +104,7 @@ def facts(
     )
     add_decisions(found, owner, reading.directive_decisions)
     _misread_and(found, owner, data)
-    call_sites = CallSites(found.get("call", []), data).sites(owner.names)
+    call_sites = _call_sites(found, data, owner, damaged)
     bound = bindings(found.get("bind", []), clean, owner.names)
     found_warnings: tuple[ParseWarning, ...] = ()
     if trust is not None:
@@ -129,6 +138,23 @@ def facts(
         sloc=sloc(clean),
         warnings=found_warnings,
     )
+
+
+def _call_sites(
+    found: dict[str, list[Node]], data: bytes, owner: Owners, damaged: bool
+) -> tuple[CallSite, ...]:
+    """The file's call sites: calls, with their targets and template arguments; objects
+    constructed without a call expression (``T x(a);``, a member's initializer); and, in a
+    damaged file, macros called alone on their line (``PLUGINLIB_EXPORT_CLASS(...)``)."""
+    constructs = in_order(found.get("construct", []))
+    wanted = initialized_members(constructs, data) if constructs else set()
+    members = field_types(found.get("field", []), data, wanted) if wanted else {}
+    targets = call_targets(
+        [*found.get("bind", []), *(n for n in constructs if n.type == "field_initializer")], data
+    )
+    constructed = [c for node in constructs for c in constructions(node, data, members, targets)]
+    called = macro_calls(data, ()) if damaged else []
+    return CallSites(found.get("call", []), data, targets).sites(owner.names, constructed, called)
 
 
 @dataclass(slots=True)

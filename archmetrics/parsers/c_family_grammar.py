@@ -59,8 +59,18 @@ def _patterns(language: TSLanguage, rules: Mapping[str, c_tables.StatementRule])
         f"[{classes}] @class",
         f"({c_tables.NAMESPACE}) @namespace",
         "(call_expression) @call",
+        # constructor calls without a call expression (c_family_constructs.py)
+        "[(new_expression) (field_initializer)] @construct",
+        "(declaration declarator: (init_declarator value: [(argument_list) (initializer_list)]))"
+        " @construct",
+        # ``T x(a);`` in a body: read as a function declaration, taken as a construction
+        "(compound_statement (declaration declarator: (function_declarator)) @construct)",
+        "(field_declaration type: (_) declarator: (field_identifier)) @field",
         "[(init_declarator) (assignment_expression) (preproc_def)] @bind",
         "(field_declaration default_value: (_)) @bind",  # c_family_bindings
+        # C++ type aliases; C has no alias_declaration, so this pattern is C++ only
+        "[(alias_declaration) (using_declaration) (type_definition declarator: (type_identifier))]"
+        " @bind",
         "(comment) @comment",
         "(ERROR) @error",
         "(MISSING) @missing",

@@ -403,3 +403,31 @@ def blank_macros(
             continue
         blank(out, start, end)
     return bytes(out)
+
+
+# A macro called alone on its line between declarations: group 1 its name, group 2 its
+# argument list (PLUGINLIB_EXPORT_CLASS(a::B, c::D), RCLCPP_COMPONENTS_REGISTER_NODE(x::Y))
+_MACRO_CALL = re.compile(
+    rb"(?:\A|\n)[ \t]*+(" + _MACRO + rb")(" + _ARGS + rb")[ \t]*+;?[ \t]*+(?://[^\n]*+)?(?=\n|\Z)"
+    rb"(?!\s*[{:,.=])"
+)
+
+
+def macro_calls(data: bytes, bodies: Iterable[tuple[int, int]]) -> list[tuple[int, int, int]]:
+    """Macros called alone on their line between declarations, outside function ``bodies``,
+    directives, comments and literals: (where the name starts, where the argument list
+    starts, where it ends). tree-sitter reads such a call without its ``;`` as damage, and
+    the macro rules above blank it; these are the calls it was (facts.CallSite)."""
+    in_body = _Ranges(list(bodies))
+    directive = directive_spans(data)
+    literal: _Ranges | None = None
+    found = []
+    for match in _MACRO_CALL.finditer(data):
+        start = match.start(1)
+        if start in in_body or start in directive:
+            continue
+        literal = literal_spans(data) if literal is None else literal
+        if start in literal:
+            continue
+        found.append((start, match.start(2), match.end(2)))
+    return found

@@ -116,6 +116,7 @@ def parse_with_libcst(path: str, source: str, limits: ParseLimits = DEFAULT_LIMI
             module._codegen(walker)
     except RecursionError:
         return _unparsed(path, 1, "Python source nested too deeply to measure")
+    walker.give_targets()
     return FileFacts(
         path=path,
         language=Language.PYTHON,

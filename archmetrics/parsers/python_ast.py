@@ -34,7 +34,7 @@ from archmetrics.parsers.python_ast_rules import (
     docstring,
     statement_text,
 )
-from archmetrics.parsers.python_bindings import assignment_bindings
+from archmetrics.parsers.python_bindings import assignment_bindings, assignment_target
 from archmetrics.parsers.python_lex import Unreadable
 from archmetrics.parsers.python_shown import PendingCall
 
@@ -110,6 +110,10 @@ class _Reader(ExpressionReader):
         if kind == "assign" or kind == "annassign":
             found = assignment_bindings(kind, self.tokens.text[first:end])
             self.bindings += [Binding(n, v, span.start, self.owner()) for n, v in found]
+            assigned = assignment_target(kind, self.tokens.text[first:end])
+            if assigned is not None:
+                name, start, stop = assigned
+                self.assigned[first + start] = (name, first + stop)
 
     # -- blocks and simple statements -------------------------------------------------------
     def body(self, statements: list[ast.stmt], target: Frame | None, docstrings: bool) -> None:

@@ -20,6 +20,7 @@ from archmetrics.parsers.python_ast_rules import (
     STRING_TEMPLATES,
     replacement_fields,
 )
+from archmetrics.parsers.python_bindings import accessors_only
 from archmetrics.parsers.python_lex import LineOffsets, Tokens, Unreadable
 from archmetrics.parsers.python_shown import PendingCall, Shown, call_site, texts_of
 
@@ -53,6 +54,8 @@ class ExpressionReader:
         self.tokens.texts = Shown(self.tokens.text, precise=True)
         self.funcs: list[Frame] = []  # enclosing functions: statements and calls go to [-1]
         self.calls: list[tuple[tuple[int, int], CallSite | PendingCall]] = []
+        # assigned values: their first token -> (the target, the token after the value)
+        self.assigned: dict[int, tuple[str, int]] = {}
 
     # -- positions --------------------------------------------------------------------------
     def first(self, node: ast.AST, tokens: Tokens | None = None) -> int:
@@ -155,11 +158,16 @@ class ExpressionReader:
         texts = texts_of(tokens)
         order = (tokens.base + tokens.offsets[first], -(tokens.base + tokens.offsets[close]))
         function = self.owner()
+        target = None
+        if tokens is self.tokens and first in self.assigned:
+            name_, stop = self.assigned[first]
+            if close + 1 == stop or accessors_only(tokens.text[close + 1 : stop]):
+                target = name_
         if texts.note_call(first, open_, close + 1):  # long: its texts wait for all calls
-            pending = PendingCall(texts, callee, name, receiver, span, arguments, function)
-            self.calls.append((order, pending))
+            made = PendingCall(texts, callee, name, receiver, span, arguments, function, target)
+            self.calls.append((order, made))
         else:
-            site = call_site(texts, callee, name, receiver, span, arguments, function)
+            site = call_site(texts, callee, name, receiver, span, arguments, function, target)
             self.calls.append((order, site))
 
     def field_tokens(self, value: ast.expr) -> Tokens:

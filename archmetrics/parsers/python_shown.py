@@ -142,6 +142,7 @@ class PendingCall:
     span: Span
     arguments: tuple[tuple[Text, Literal, bool, str | None], ...]  # text, value, literal?, keyword
     function: str | None
+    target: str | None = None
 
     def site(self) -> CallSite:
         return call_site(
@@ -152,6 +153,7 @@ class PendingCall:
             self.span,
             self.arguments,
             self.function,
+            self.target,
         )
 
 
@@ -163,6 +165,7 @@ def call_site(
     span: Span,
     arguments: tuple[tuple[Text, Literal, bool, str | None], ...],
     function: str | None,
+    target: str | None = None,
 ) -> CallSite:
     """The call site with these texts made (``name`` None: the callee's text)."""
     resolve = texts.resolve
@@ -172,4 +175,5 @@ def call_site(
         for text, value, is_literal, keyword in arguments
     )
     shown_receiver = None if receiver is None else resolve(receiver)
-    return CallSite(callee, callee if name is None else name, shown_receiver, span, made, function)
+    name = callee if name is None else name
+    return CallSite(callee, name, shown_receiver, span, made, function, (), target)

@@ -24,7 +24,11 @@ from archmetrics.facts import (
 )
 from archmetrics.parsers import python_calls as calls
 from archmetrics.parsers import python_rules as rules
-from archmetrics.parsers.python_bindings import assignment_bindings
+from archmetrics.parsers.python_bindings import (
+    accessors_only,
+    assignment_bindings,
+    assignment_target,
+)
 from archmetrics.parsers.python_shown import PendingCall, Shown, call_site
 from archmetrics.parsers.python_tokens import Hook, TokenState
 
@@ -58,6 +62,8 @@ class FactsWalker(TokenState):
         self.dependencies: list[Dependency] = []
         self.bindings: list[Binding] = []
         self.calls: list[CallSite | PendingCall | None] = []
+        self.call_ranges: list[tuple[int, int]] = []  # each call's first token and its ")"
+        self.assigned: dict[int, tuple[str, int]] = {}  # as python_ast_expressions keeps it
         self.docstrings: set[int] = set()
         self.elifs: set[int] = set()
         self.else_kinds: dict[int, str] = {}
@@ -87,6 +93,10 @@ class FactsWalker(TokenState):
         if kind == "assign" or kind == "annassign":
             found = assignment_bindings(kind, self.toks[first:end])
             self.bindings += [Binding(n, v, span.start, self.owner()) for n, v in found]
+            assigned = assignment_target(kind, self.toks[first:end])
+            if assigned is not None:
+                name, start, stop = assigned
+                self.assigned[first + start] = (name, first + stop)
 
     def decide(self, kind: str) -> None:
         """A decision point at the next token (its line: that token's, also inside an
@@ -241,6 +251,7 @@ class FactsWalker(TokenState):
     def enter_call(self, node: cst.Call) -> None:
         self.call_starts.append((len(self.toks), len(self.calls), self.next_line()))
         self.calls.append(None)
+        self.call_ranges.append((-1, -1))
 
     def enter_arg(self, node: cst.Arg) -> None:
         self.arg_starts[id(node)] = len(self.toks)
@@ -261,6 +272,23 @@ class FactsWalker(TokenState):
         span = Span(line, max(line, self.last_line(end)))
         made = PendingCall if long else call_site  # a long call's texts wait for all calls
         self.calls[slot] = made(self.shown, callee, name, receiver, span, arguments, self.owner())
+        if not self.fstring_depth:
+            self.call_ranges[slot] = (first + len(node.lpar), end - len(node.rpar) - 1)
+
+    def give_targets(self) -> None:
+        """Give each call whose value an assignment keeps (alone, or followed by accessors
+        only) its target, as the ``ast`` reader does (python_bindings.assignment_target)."""
+        for slot, (first, close) in enumerate(self.call_ranges):
+            found = self.assigned.get(first)
+            call = self.calls[slot]
+            if found is None or call is None:
+                continue
+            name, stop = found
+            if close + 1 == stop or accessors_only(self.toks[close + 1 : stop]):
+                if isinstance(call, PendingCall):
+                    call.target = name
+                else:
+                    self.calls[slot] = call._replace(target=name)
 
 
 def parameters(node: cst.FunctionDef) -> tuple[str, ...]:

@@ -82,6 +82,24 @@ def _toml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileF
     return config_toml.parse(path, source, limits)
 
 
+def _xml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    from archmetrics.parsers import config_xml
+
+    return config_xml.parse(path, source, limits)
+
+
+def _yaml(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    from archmetrics.parsers import config_yaml
+
+    return config_yaml.parse(path, source, limits)
+
+
+def _rosidl(path: str, source: str, limits: ParseLimits = DEFAULT_LIMITS) -> FileFacts:
+    """A ROS interface definition: no executable code, no table; listed so that the
+    includes and imports of the code generated from it depend on it (coupling/interfaces.py)."""
+    return FileFacts(path=path, language=ConfigFormat.ROSIDL.value)
+
+
 BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     LanguageSpec(Language.PYTHON, _python, _python),
     LanguageSpec(Language.C, _c, _c),
@@ -89,6 +107,9 @@ BUILTIN_LANGUAGES: tuple[LanguageSpec, ...] = (
     # configuration formats: no file ending maps to them; the rule packs say which files
     # are configuration (docs/metrics.md, "Configuration links")
     LanguageSpec(ConfigFormat.TOML, _toml, _toml),
+    LanguageSpec(ConfigFormat.XML, _xml, _xml),
+    LanguageSpec(ConfigFormat.YAML, _yaml, _yaml),
+    LanguageSpec(ConfigFormat.ROSIDL, _rosidl, _rosidl),
 )
 
 

@@ -94,6 +94,11 @@ def site_dict(site: LinkSite) -> dict[str, Any]:
         "targets": list(site.targets),
         "function": site.function,
         "note": site.note or None,
+        # graph names (ROS): the data type, the name as written, the node, further keys
+        "endpoint_type": site.data_type or None,
+        "endpoint_name": site.name or None,
+        "node": site.node or None,
+        "also_endpoints": list(site.endpoint.also) if site.endpoint else [],
     }
 
 

@@ -90,6 +90,23 @@ def element_row(e: ElementChange) -> list[str]:
     ]
 
 
+LINK_HEADER = ("element", "change", "role", "endpoint", "sites")
+_ROLE_WORDS = {"initiate": "initiates", "receive": "receives", "use": "uses"}
+
+
+def link_rows(changed: list[ElementChange]) -> list[list[str]]:
+    """Per changed element, the link sites added (+) and removed (-), by role and endpoint
+    (``?``: not known statically), with how many sites each is."""
+    rows: list[list[str]] = []
+    for e in changed:
+        for sign, changes in (("+", e.links_added), ("-", e.links_removed)):
+            rows += [
+                [e.element, sign, _ROLE_WORDS.get(role, role), key or "?", str(count)]
+                for role, key, count in changes
+            ]
+    return rows
+
+
 def notes(report: DiffReport) -> list[str]:
     """Every note once, prefixed with the locations it applies to."""
     where: dict[str, list[str]] = {}

@@ -159,9 +159,24 @@ def render_diff(report: DiffReport, max_rows: int | None = None) -> str:
     tail = ["\n".join(bullets) + "\n"] if bullets else []
     changed = report.change.changed()
     if changed:
-        budget = COMMENT_LIMIT - _ROOM - len("\n".join(parts + tail))
+        links = _links(changed)
+        budget = COMMENT_LIMIT - _ROOM - len("\n".join(parts + tail + links))
         parts += _elements(changed, budget, max_rows)
+        if len("\n".join(parts + links + tail)) <= COMMENT_LIMIT - _ROOM:
+            parts += links
     return "\n".join(parts + tail)
+
+
+def _links(changed: list[ElementChange]) -> list[str]:
+    """The link sites each changed element gains and loses (+/-), by role and endpoint."""
+    rows = diff_rows.link_rows(changed)
+    if not rows:
+        return []
+    return [
+        f"<details><summary>{len(rows)} link changes</summary>\n",
+        table(list(diff_rows.LINK_HEADER), _coded(rows, 0, 3), "lllll"),  # names as code
+        "</details>\n",
+    ]
 
 
 def _excluded(files: Iterable[ExcludedFile]) -> list[str]:

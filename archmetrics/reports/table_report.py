@@ -187,6 +187,10 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     least_useful = ("d_e", "d_a", "s_e", "s_a", "location", "λ pre", "v_g pre")
     title = "changed elements, the most changed first"
     detail = rows_table(title, diff_rows.ELEMENT_HEADER, changed, 3, None, least_useful)
+    linked = diff_rows.link_rows(report.change.changed())
+    tables = [summary, detail]
+    if linked:
+        tables.append(rows_table("links added and removed", diff_rows.LINK_HEADER, linked, 1))
     unchanged = report.change.unchanged_count()
     lines = [f"{unchanged} unchanged elements not shown (see --format json)"] if unchanged else []
     lines.append(legend_lines(DIFF_LEGEND))
@@ -200,7 +204,7 @@ def render_diff(report: DiffReport, color: bool = False) -> str:
     lines += [str(f) for f in report.failures]
     lines += gate_lines(report)
     lines.append(f"verdict: {diff_rows.verdict(report)}")
-    return to_text(summary, detail, color=color) + "".join(line + "\n" for line in lines)
+    return to_text(*tables, color=color) + "".join(line + "\n" for line in lines)
 
 
 def render_series(report: SeriesReport, color: bool = False) -> str:

@@ -77,7 +77,8 @@ def _json(document: Any) -> bytes:
 def encode(facts: FileFacts) -> bytes:
     # records are named tuples: json writes each as a list in its fields' order, in C
     statements = _json(tuple(facts.statements))  # [kind, [start, end], text, function]
-    calls = _json(tuple(facts.call_sites))  # [callee, name, receiver, span, arguments, fn]
+    calls = _json(tuple(facts.call_sites))  # [callee, name, receiver, span, args, fn, templates,
+    # target]
     bindings = _json(tuple(facts.bindings))  # [name, value, line, function]
     document = [
         FORMAT,
@@ -107,7 +108,10 @@ def encode(facts: FileFacts) -> bytes:
         [[w.line, w.message, str(w.severity)] for w in facts.warnings],
         facts.parsed,
         facts.generated,
-        [[list(t.keys), t.line, [[k, list(vs)] for k, vs in t.values]] for t in facts.tables],
+        [
+            [list(t.keys), t.line, [[k, list(vs)] for k, vs in t.values], t.parent]
+            for t in facts.tables
+        ],
     ]
     # four lines: JSON escapes the newlines inside strings
     return b"\n".join((_json(document), calls, statements, bindings))
@@ -231,7 +235,7 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
         made = tuple([_new(Argument, (intern(t), v, lit, kw)) for t, v, lit, kw in args])
         return lists.setdefault(made, made)
 
-    return [
+    made = [
         _new(
             CallSite,
             (
@@ -241,10 +245,19 @@ def _calls(rows: list[list[Any]]) -> list[CallSite]:
                 spans[a, b],
                 arguments(args),
                 fn and intern(fn),
+                tuple(templates) if templates else (),
+                target,
             ),
         )
-        for callee, call, recv, (a, b), args, fn in rows
+        for callee, call, recv, (a, b), args, fn, templates, target in rows
     ]
+    if not all(
+        all(type(t) is str for t in call.templates)
+        and (call.target is None or type(call.target) is str)
+        for call in made
+    ):
+        raise ValueError("a call's template arguments or target are not text")
+    return made
 
 
 _T = TypeVar("_T")
@@ -355,16 +368,18 @@ def _decode(
         warnings=tuple(ParseWarning(path, line, m, Severity(sev)) for line, m, sev in warnings),
         parsed=parsed,
         generated=generated,
-        tables=tuple([_table(keys, line, values) for keys, line, values in tables]),
+        tables=tuple([_table(*table) for table in tables]),
     )
 
 
-def _table(keys: list[Any], line: Any, values: list[Any]) -> ConfigTable:
+def _table(keys: list[Any], line: Any, values: list[Any], parent: Any) -> ConfigTable:
     """A configuration table read back, every part checked (the cache is not trusted)."""
     texts = [*keys, *(k for k, _ in values), *(v for _, vs in values for v in vs)]
     if not all(isinstance(t, str) for t in texts) or type(line) is not int or line < 1:
         raise CodecError("a configuration table of other than text and a line")
-    return ConfigTable(tuple(keys), line, tuple((k, tuple(vs)) for k, vs in values))
+    if type(parent) is not int or parent < -1:
+        raise CodecError("a configuration table's parent is not an index")
+    return ConfigTable(tuple(keys), line, tuple((k, tuple(vs)) for k, vs in values), parent)
 
 
 def decode(

@@ -55,7 +55,7 @@ FORMAT = 4
 _PARSED, _GENERATED = 1, 2
 _SEVERITIES = tuple(s.value for s in Severity)
 _SEVERITY_MEMBERS = tuple(Severity)
-_ROLES = ("initiate", "receive", "use")
+_ROLES = ("initiate", "receive", "use", "also")
 _LOCATIONS = tuple(loc for loc in Location)
 
 
@@ -88,6 +88,7 @@ def encode(state: TreeState) -> bytes:
         flags = (_PARSED if row.parsed else 0) | (_GENERATED if row.generated else 0)
         numbers += (row.loc, row.sloc, row.vg, flags, language[row.language])
     members, sizes = _flat([at[p] for p in e.files] for e in index.elements)
+    element_at = {e.name: i for i, e in enumerate(index.elements)}
     kinds, kind_sizes = _flat([language[lang] for lang in e.languages] for e in index.elements)
     dep_files = list(index.deps)
     deps, dep_sizes = _flat(index.deps[p] for p in dep_files)
@@ -121,6 +122,11 @@ def encode(state: TreeState) -> bytes:
             [key for _, key in sites],
         ],
         "values": [n for e in index.elements for n in index.values[e.name]],
+        "receivers": [
+            [key, sorted(element_at[name] for name in names)]
+            for key, names in sorted(index.receivers.items())
+        ],
+        "whole": index.whole,
         "groups": _groups(state, at),
         "table": _table_columns(state, at),
         "excluded": [[at[x.path] for x in state.excluded], [x.reason for x in state.excluded]],
@@ -189,7 +195,11 @@ def decode(data: bytes) -> TreeState:
     columns = (numbers[0::4], numbers[1::4], numbers[2::4], numbers[3::4])
     named = [e.name for e in elements]
     values: dict[str, Values] = dict(zip(named, zip(*columns, strict=True), strict=True))
-    index = CouplingIndex(paths, elements, deps, sites, values)
+    receivers = _receivers(document.get("receivers"), [e.name for e in elements])
+    whole = document.get("whole")
+    if not isinstance(whole, bool):
+        raise _bad("no whole flag")
+    index = CouplingIndex(paths, elements, deps, sites, values, receivers, whole)
     _consistent(files, index, deps)
     groups = elements
     if document.get("groups") is not None:
@@ -293,6 +303,18 @@ def _elements(value: object, files: list[str], languages: list[str]) -> tuple[El
             langs.append(found)
         start = end
     return _grouped(names, members, sizes, files, langs)
+
+
+def _receivers(value: object, names: list[str]) -> dict[str, frozenset[str]]:
+    """Keys received without a site, each with the elements (by position) receiving it."""
+    if not isinstance(value, list):
+        raise _bad("no receivers")
+    found: dict[str, frozenset[str]] = {}
+    for entry in value:
+        if not (isinstance(entry, list) and len(entry) == 2 and isinstance(entry[0], str)):
+            raise _bad("a receiver that is not a key and its elements")
+        found[entry[0]] = frozenset(names[i] for i in _ints(entry[1], 0, len(names)))
+    return found
 
 
 def _sites(value: object, files: list[str]) -> dict[str, tuple[Site, ...]]:

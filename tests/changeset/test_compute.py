@@ -209,6 +209,8 @@ def test_report_json_shape() -> None:
         "added",
         "removed",
         "modified",
+        "links_added",
+        "links_removed",
     ]
     assert list(record["pre"]) == ["loc", "sloc", "vg", "s_a", "s_e", "d_a", "d_e"]
     assert record["status"] == "modified" and record["modified"] == 1

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from hypothesis import given
+import functools
+
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from archmetrics.coupling.dynamic import RuleIndex, matches, normalize_callee, rule_index
@@ -34,6 +36,7 @@ def test_normalize_callee_is_idempotent_and_a_callee_matches_itself_as_a_pattern
         assert matches(once, text)
 
 
+@functools.cache
 def _indexes() -> list[RuleIndex]:
     rules = load_rule_packs([]).rules
     return [
@@ -46,6 +49,7 @@ def _indexes() -> list[RuleIndex]:
 _NAMES = sorted({p.replace("*", "x") for r in load_rule_packs([]).rules for p in r.match})
 
 
+@settings(deadline=None)  # no timing in tests: a loaded machine takes 200 ms for one
 @given(
     st.one_of(
         st.sampled_from(_NAMES),

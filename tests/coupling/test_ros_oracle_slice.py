@@ -33,7 +33,6 @@ from typing import Any, NoReturn
 import pytest
 
 from archmetrics.cli import main
-from archmetrics.coupling import load_rule_packs
 from tests.coupling.ros_adapter import KIND_CATEGORY, is_ros_site, kind_family, ros_endpoint
 from tests.coupling.ros_rows import (
     NAMED_ISSUE,
@@ -43,9 +42,6 @@ from tests.coupling.ros_rows import (
     match_sites,
     parse_rows,
 )
-
-if not any(pack.name.startswith("ros") for pack in load_rule_packs().packs):
-    pytest.skip("no ROS rule pack (ros1, ros2) is loaded yet", allow_module_level=True)
 
 CASES = Path(__file__).resolve().parent / "ros_cases"
 ROWS = parse_rows((CASES / "cases.sites").read_text(encoding="utf-8"), "cases.sites")
@@ -89,7 +85,23 @@ def _where(row: Row) -> str:
     return f"{row.file}:{row.line} {row.kind} {';'.join(row.names)}"
 
 
-@pytest.mark.parametrize("case", NAMES)
+#: Cases whose sites are known not to be read yet, each with why (docs/metrics.md, "ROS"): strict,
+#: so that a case read correctly fails until it leaves this list.
+NOT_YET = {
+    "rclcpp_helpers": "a helper's topic argument is named by its callers; names are not "
+    "followed from a call into the function it calls",
+}
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        pytest.param(name, marks=pytest.mark.xfail(reason=NOT_YET[name], strict=True))
+        if name in NOT_YET
+        else name
+        for name in NAMES
+    ],
+)
 def test_each_site_of_the_case_is_found_and_nothing_else(case: str, reported: list[Site]) -> None:
     rows = [row for row in ROWS if row.file.startswith(f"{case}/")]
     sites = [site for site in reported if str(site["path"]).startswith(f"{case}/")]

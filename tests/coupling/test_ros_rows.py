@@ -205,18 +205,33 @@ def _consistent(rows: list[Row], sites: str) -> None:
 
 def test_a_site_becomes_kind_name_and_type() -> None:
     site = {
-        "path": "src/a.cpp", "line": 3, "rule": "ros2/cpp-create-publisher", "kind": "message",
-        "role": "send", "endpoint": "/cmd_vel", "status": "external",
-        "type": "geometry_msgs/msg/Twist", "extra": [1],
+        "path": "src/a.cpp", "line": 3, "rule": "ros2/publisher", "kind": "messaging",
+        "role": "initiate", "endpoint": "topic:/cmd_vel", "status": "external",
+        "endpoint_type": "geometry_msgs/msg/Twist", "endpoint_name": "topic:cmd_vel",
+        "node": "/teleop", "extra": [1],
     }  # fmt: skip
     assert is_ros_site(site) and not is_ros_site({**site, "rule": "zeromq/socket-connect"})
     assert ros_endpoint(site) == ("publisher", "/cmd_vel", "geometry_msgs/msg/Twist")
-    unresolved = {**site, "rule": "ros1/py-subscriber", "status": "unresolved", "type": None}
+    tf = {**site, "rule": "ros2/tf-broadcaster", "endpoint": "topic:/tf"}
+    assert ros_endpoint(tf)[:2] == ("publisher", "/tf")
+    unresolved = {**site, "rule": "ros1/py-subscriber", "status": "unresolved",
+                  "endpoint_type": None}  # fmt: skip
     assert ros_endpoint(unresolved) == ("subscription", None, None)
     assert ros_endpoint({"rule": "ros2/py-spin", "role": "receive"})[0] == "subscription"
-    export = {"rule": "ros2/cpp-pluginlib-export", "endpoint": "demo::Talker", "status": "local"}
+    export = {"rule": "ros2/plugin-export", "endpoint": "plugin:demo::Talker", "status": "local"}
     assert ros_endpoint(export) == ("plugin-export", "demo::Talker", None)
-    assert ros_endpoint({**export, "endpoint": "plugin:nav2/Navfn"})[1] == "nav2/Navfn"
+    load = {"rule": "ros1/plugin-load", "endpoint": "plugin:navfn::NavfnROS",
+            "endpoint_name": "plugin:navfn/NavfnROS", "status": "resolved"}  # fmt: skip
+    assert ros_endpoint(load) == ("plugin-load", "navfn/NavfnROS", None)  # the lookup name
+    described = {"rule": "ros2/plugin-description", "endpoint": "plugin:navfn::NavfnROS",
+                 "endpoint_text": "navfn/NavfnROS", "status": "resolved"}  # fmt: skip
+    assert ros_endpoint(described)[:2] == ("plugin-description", "navfn/NavfnROS")
+    declared = {"rule": "ros2/declare-parameter", "endpoint": "parameter:/teleop/speed",
+                "endpoint_name": "parameter:~/speed", "status": "external"}  # fmt: skip
+    assert ros_endpoint(declared)[:2] == ("param-declare", "speed")  # as declared
+    launched = {"rule": "ros2/launch-file", "endpoint": "plugin:demo::Talker",
+                "node": "/robot1/talker", "status": "resolved"}  # fmt: skip
+    assert ros_endpoint(launched) == ("launch-component", "/robot1/talker", None)
 
 
 def test_the_slice_table_names_lines_of_its_snippets() -> None:

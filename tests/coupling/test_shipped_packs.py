@@ -12,6 +12,7 @@ from tests.coupling.trees import BUILTIN, measure
 
 EXPECTED_PACKS = {
     "posix-sockets", "dynamic-loading", "cpp-rtti", "zeroc-ice", "zeromq", "player", "robosoa",
+    "ros1", "ros2",
 }  # fmt: skip
 _PATHS = {"python": "example.py", "c": "example.c", "cpp": "example.cpp"}
 _CASES = [

@@ -47,13 +47,34 @@ def test_cpp_members_references_and_brace_initializers() -> None:
     source = """
     namespace n { const int kPort = 5; class C { static constexpr int P = 7; }; }
     void g() { auto &r = x; std::string s("a"); int y{3}; int z = 4; }
+    void C::h() { this->topic_ = "cmd_vel"; other->x = 1; }
     """
     assert _bound(source, "cpp") == [
         ("kPort", "5", 2, None),
         ("P", "7", 2, None),
         ("r", "x", 3, "g"),
         ("z", "4", 3, "g"),
+        ("this->topic_", '"cmd_vel"', 4, "C::h"),  # a member of this; other->x is not bound
     ]
+
+
+def test_cpp_type_aliases_bind_their_names_to_the_types() -> None:
+    source = """
+    using Msg = std_msgs::msg::String;
+    using std_msgs::msg::Int32;
+    using namespace std;
+    using namespace a::b;
+    typedef a::B C;
+    typedef void (*F)(int);
+    void g() { using T = q::R<int>; }
+    """
+    assert _bound(source, "cpp") == [
+        ("Msg", "std_msgs :: msg :: String", 2, None),
+        ("Int32", "std_msgs :: msg :: Int32", 3, None),
+        ("C", "a :: B", 6, None),  # a typedef of one plain name; F binds nothing
+        ("T", "q :: R < int >", 8, "g"),
+    ]
+    assert _bound("typedef struct s s_t;\n", "c") == []  # C has no type aliases here
 
 
 def test_c_parameters_are_named_through_their_declarators() -> None:
@@ -89,6 +110,7 @@ def test_python_assignments_bind_plain_names_in_both_readers() -> None:
         Binding("A", "( 1 , 2 )", 3),
         Binding("B", "( 1 , 2 )", 3),
         Binding("f", "lambda x = 1 : x", 4),
+        Binding("self.x", "3", 5),  # a member of the object at hand
         Binding("X", "3", 8),
         Binding("fd", "os . open ( p , 1 )", 11, "g"),
     ]
@@ -104,4 +126,4 @@ def test_python_assignments_bind_plain_names_in_both_readers() -> None:
 def test_assignment_bindings_never_raise_and_bind_names(tokens: list[str]) -> None:
     for kind in ("assign", "annassign", "expr"):
         for name, value in assignment_bindings(kind, tokens):
-            assert name.isidentifier() and value
+            assert name.removeprefix("self.").isidentifier() and value

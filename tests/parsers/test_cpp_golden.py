@@ -274,6 +274,99 @@ def test_method_call_on_a_call_result_keeps_the_whole_receiver() -> None:
     assert inner.callee == "a.b"
 
 
+def test_template_arguments_and_targets_of_calls() -> None:
+    source = """
+    void Talker::start() {
+        pub_ = this->create_publisher<geometry_msgs::msg::Twist>("cmd_vel", 10);
+        this->timer_ = create_wall_timer(period, cb);
+        auto q = rclcpp::create_publisher<std::map<K, V>, Alloc>(node, "x", 10);
+        topic_ = this->get_parameter("topic").as_string();
+        sink(std::make_shared<tf2_ros::TransformBroadcaster>(this));
+    }
+    """
+    calls = [(k.callee, k.templates, k.target) for k in cpp(source).call_sites]
+    assert calls == [
+        ("this->create_publisher", ("geometry_msgs::msg::Twist",), "pub_"),
+        ("create_wall_timer", (), "this->timer_"),
+        ("rclcpp::create_publisher", ("std::map<K,V>", "Alloc"), "q"),
+        ('this->get_parameter("topic").as_string', (), "topic_"),
+        ("this->get_parameter", (), "topic_"),  # the head of an accessor chain
+        ("sink", (), None),
+        ("std::make_shared", ("tf2_ros::TransformBroadcaster",), None),
+    ]
+
+
+def test_constructor_calls_without_a_call_expression_are_call_sites() -> None:
+    source = """
+    class Talker : public rclcpp::Node {
+    public:
+      Talker() : Node("talker"), as_(nh_, "fibonacci", false), pub_(make_pub("chatter")) {
+        listener_ = new tf2_ros::TransformListener(buffer_);
+        message_filters::Subscriber<Image> sub(this, "image"), other{this, "depth"};
+      }
+      actionlib::SimpleActionServer<FibonacciAction> as_;
+    };
+    """
+    calls = [
+        (k.callee, k.name, k.receiver, k.templates, k.target, [a.text for a in k.arguments])
+        for k in cpp(source).call_sites
+    ]
+    assert calls == [
+        ("Node", "Node", None, (), None, ['"talker"']),
+        ("actionlib::SimpleActionServer", "SimpleActionServer", "actionlib",
+         ("FibonacciAction",), "as_", ["nh_", '"fibonacci"', "false"]),
+        ("pub_", "pub_", None, (), None, ['make_pub("chatter")']),  # type declared elsewhere
+        ("make_pub", "make_pub", None, (), "pub_", ['"chatter"']),
+        ("tf2_ros::TransformListener", "TransformListener", "tf2_ros", (), "listener_",
+         ["buffer_"]),
+        ("message_filters::Subscriber", "Subscriber", "message_filters", ("Image",), "sub",
+         ["this", '"image"']),
+        ("message_filters::Subscriber", "Subscriber", "message_filters", ("Image",), "other",
+         ["this", '"depth"']),
+    ]  # fmt: skip
+    assert {k.function for k in cpp(source).call_sites} == {"Talker::Talker"}
+
+
+def test_a_construction_read_as_a_function_declaration_is_a_call_site() -> None:
+    source = """
+    void f(int);
+    int main() {
+      tf2_ros::TransformListener listener(buffer);
+      ros::NodeHandle child(nh, ns);
+      int g(int);
+      std::string h(std::string);
+    }
+    """
+    calls = [
+        (k.callee, k.span.start, k.target, [a.text for a in k.arguments])
+        for k in cpp(source).call_sites
+    ]
+    assert calls == [
+        ("tf2_ros::TransformListener", 4, "listener", ["buffer"]),
+        ("ros::NodeHandle", 5, "child", ["nh", "ns"]),
+    ]  # the declarations at file scope, of a primitive type or a qualified parameter stay
+
+
+def test_a_macro_called_alone_between_declarations_is_a_call_site() -> None:
+    source = """
+    #include "pluginlib/class_list_macros.hpp"
+    namespace nav2_navfn_planner { void plan() {} }
+    PLUGINLIB_EXPORT_CLASS(nav2_navfn_planner::NavfnPlanner, nav2_core::GlobalPlanner)
+    RCLCPP_COMPONENTS_REGISTER_NODE(composition::Talker);
+    SET_NAME("x")
+    """
+    calls = [
+        (k.callee, k.span.start, k.function, [(a.text, a.value) for a in k.arguments])
+        for k in cpp(source).call_sites
+    ]
+    assert calls == [
+        ("PLUGINLIB_EXPORT_CLASS", 4, None,
+         [("nav2_navfn_planner::NavfnPlanner", None), ("nav2_core::GlobalPlanner", None)]),
+        ("RCLCPP_COMPONENTS_REGISTER_NODE", 5, None, [("composition::Talker", None)]),
+        ("SET_NAME", 6, None, [('"x"', "x")]),
+    ]  # fmt: skip
+
+
 # --- headers and robustness ---------------------------------------------------------------------
 
 

@@ -607,6 +607,32 @@ def test_true_false_and_none_are_names_to_a_callee() -> None:
     assert calls("True.__index__()\n") == [("True.__index__", "__index__", "True")]
 
 
+def test_a_call_assigned_alone_or_before_accessors_has_its_target() -> None:
+    source = """
+    class Talker(Node):
+        def __init__(self):
+            self.pub = self.create_publisher(String, 'chatter', 10)
+            topic = self.declare_parameter('topic', 'chatter').value
+            t: str = (self.get_parameter('t').get_parameter_value().string_value)
+            a = b = make(2)
+            y = h(1).k(2)
+            self.pub.publish(String(data='hi'))
+    """
+    facts = py(source)
+    found = [(c.callee, c.target) for c in facts.call_sites]
+    assert found == [
+        ("self.create_publisher", "self.pub"),
+        ("self.declare_parameter", "topic"),
+        ("self . get_parameter ( 't' ) . get_parameter_value", "t"),
+        ("self.get_parameter", "t"),
+        ("make", "b"),  # the last target of a chain of them
+        ("h ( 1 ) . k", "y"),
+        ("h", None),  # k's argument makes it no accessor
+        ("self.pub.publish", None),
+        ("String", None),
+    ]
+
+
 def test_a_call_in_parentheses_spans_them() -> None:
     (site,) = py("x = (\n    connect(1)\n)\n").call_sites
     assert site.span == Span(1, 3)

@@ -73,7 +73,8 @@ def test_json_is_versioned_and_round_trips_the_graph(graph: ElementGraph) -> Non
              for e in document["edges"]]  # fmt: skip
     assert tuple(edges) == graph.edges
     assert {"source": "nav/publisher.py", "target": "nav/subscriber.py", "kind": "dynamic",
-            "label": "topic:pose", "weight": 2} in document["edges"]  # fmt: skip
+            "label": "topic:pose", "weight": 2, "role": None} in document["edges"]  # fmt: skip
+    assert document["view"] == "elements"
 
 
 def test_labels_with_quotes_are_escaped() -> None:

@@ -45,6 +45,8 @@ def _same(a: TreeState, b: TreeState) -> None:
     assert dict(a.index.deps) == dict(b.index.deps)
     assert dict(a.index.sites) == dict(b.index.sites)
     assert dict(a.index.values) == dict(b.index.values)
+    assert dict(a.index.receivers) == dict(b.index.receivers)
+    assert a.index.whole == b.index.whole
     assert [(e.name, e.files) for e in a.groups] == [(e.name, e.files) for e in b.groups]
     assert dict(a.table) == dict(b.table)
     assert a.excluded == b.excluded
@@ -68,6 +70,25 @@ def test_a_state_whose_groups_differ_from_the_coupled_elements(tmp_path: Path) -
     (tmp_path / "bad.py").write_text("def f(:\n")
     state = _state(tmp_path)
     assert [e.name for e in state.groups] != [e.name for e in state.index.elements]
+    _same(decode(encode(state)), state)
+
+
+def test_a_ros_trees_receivers_and_whole_flag_come_back(tmp_path: Path) -> None:
+    """A parameter file receives the code that reads it, without a site of its own; the
+    record keeps such receivers, and that the tree is coupled whole on a patch."""
+    from tests.coupling.test_ros import LAUNCH, PARAMS, WORKSPACE
+
+    files = {**WORKSPACE, "talker_pkg/config/params.yaml": PARAMS,
+             "bringup/package.xml": "<package><name>bringup</name></package>\n",
+             "bringup/launch/demo.launch.py": LAUNCH}  # fmt: skip
+    for path, text in files.items():
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text(text)
+    state = _state(tmp_path)
+    assert state.index.whole
+    assert state.index.receivers["parameter:/robot1/talker/topic"] == frozenset(
+        {"talker_pkg/config/params.yaml"}
+    )
     _same(decode(encode(state)), state)
 
 
