@@ -12,7 +12,7 @@ from archmetrics.app.workers import Parsed, Task, WorkerLimits, parse_in_workers
 from archmetrics.config import LimitSettings, MacroSettings, Settings
 from archmetrics.facts import FileFacts, ParseWarning, Severity
 from archmetrics.parsers import LanguageTable, ParseLimits
-from archmetrics.parsers.c_family_macros import MacroNames
+from archmetrics.parsers.c_family_macro_rules import MacroNames
 from archmetrics.parsers.limits import stack_bytes, too_large
 from archmetrics.sources import Snapshot, SourceFile, codec
 from archmetrics.sources.cache import FactsCache

@@ -29,7 +29,8 @@ from archmetrics.parsers.c_family_functions import (
 )
 from archmetrics.parsers.c_family_grammar import Grammar, missing_parents
 from archmetrics.parsers.c_family_heads import KEYWORDS
-from archmetrics.parsers.c_family_macros import MacroNames, macro_calls
+from archmetrics.parsers.c_family_macro_rules import MacroNames
+from archmetrics.parsers.c_family_macros import macro_calls
 from archmetrics.parsers.c_family_names import Scopes, in_order, typedef_names
 from archmetrics.parsers.c_family_outline import classes, includes
 from archmetrics.parsers.c_family_statements import Bodies, include_guard, statements

@@ -128,7 +128,6 @@ class Scopes:
             found[node.id] = open_[-1][1] if open_ else ""
         return found
 
-
     def prefix_at(self, offset: int) -> str:
         """The qualified name of the named scopes around byte ``offset`` ("" if none)."""
         return _tail("::".join(name for start, end, name in self._named if start < offset < end))

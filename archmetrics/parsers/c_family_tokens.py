@@ -336,9 +336,7 @@ class _Reader:
                 self.state = first
 
 
-def read(
-    data: bytes, cpp: bool, windows: list[tuple[int, int]] | None = None
-) -> TokenReading:
+def read(data: bytes, cpp: bool, windows: list[tuple[int, int]] | None = None) -> TokenReading:
     """The token reading of ``data``, or of each of ``windows`` (sorted, disjoint byte
     ranges that start where the syntax tree stands between declarations). ``cpp``: C++'s
     `catch`, `and`, `or` count. A window whose reading ends inside a body or a head is read

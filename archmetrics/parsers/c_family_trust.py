@@ -28,9 +28,7 @@ from archmetrics.parsers.c_family_functions import FunctionSlot
 from archmetrics.parsers.c_family_heads import KEYWORDS
 from archmetrics.parsers.c_family_tokens import TokenFunction, TokenReading
 
-_DEFINE = re.compile(
-    rb"(?m)^[ \t]*+\#[ \t]*+define[ \t]++(\w++)(\([^)\n]*+\))?+((?:\\\n|[^\n])*+)"
-)
+_DEFINE = re.compile(rb"(?m)^[ \t]*+\#[ \t]*+define[ \t]++(\w++)(\([^)\n]*+\))?+((?:\\\n|[^\n])*+)")
 
 
 _PARENTHESES = re.compile(rb"\([^()]*+\)")

@@ -95,9 +95,7 @@ def _losses(
         shown = ", ".join(repr(name) for name in dropped[:3])
         parts.append(f"{shown} read as {'a function' if len(dropped) == 1 else 'functions'}"
                      " by mistake, not reported")  # fmt: skip
-    statements = _between(seen.statements, first, last) - _between(
-        counted.statements, first, last
-    )
+    statements = _between(seen.statements, first, last) - _between(counted.statements, first, last)
     calls = _between(seen.calls, first, last) - _between(counted.calls, first, last)
     lost = [
         _plural(n, what) for n, what in ((statements, "statement"), (calls, "call site")) if n > 0

@@ -12,7 +12,7 @@ import threading
 from dataclasses import dataclass, field
 
 from archmetrics.facts import FileFacts, ParseWarning, Severity
-from archmetrics.parsers.c_family_macros import MacroNames
+from archmetrics.parsers.c_family_macro_rules import MacroNames
 
 _MIB = 1 << 20
 _REFERENCE_STACK = 8 * _MIB  # the main thread's stack on Linux and macOS by default

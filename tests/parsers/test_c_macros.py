@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 from archmetrics.facts import FileFacts, Language, Span
 from archmetrics.parsers.c_family_grammar import differing, grammar
-from archmetrics.parsers.c_family_macros import MacroNames, blank_macros, literal_spans
+from archmetrics.parsers.c_family_macro_rules import MacroNames
+from archmetrics.parsers.c_family_macros import blank_macros, literal_spans
 from tests.harness import complexities, facts_of
 
 
@@ -468,16 +469,16 @@ _BRANCHY = [
 def test_a_rereading_gives_the_facts_a_fresh_parse_gives(monkeypatch: pytest.MonkeyPatch) -> None:
     """The second and later readings of a file (macros or #if directives blanked) let
     tree-sitter reuse the first tree; what they read must not depend on that."""
-    from archmetrics.parsers import c_family
+    from archmetrics.parsers import c_family_reading
 
     sources = [
         ("cpp", "class FOO_EXPORT A : B {\n  int f() { if (x) return 1; return 0; }\n};\n"),
         *_BRANCHY,
     ]
     incremental = [facts_of(source, language) for language, source in sources]
-    fresh_parse = c_family.syntax_tree
+    fresh_parse = c_family_reading.syntax_tree
     monkeypatch.setattr(
-        c_family,
+        c_family_reading,
         "syntax_tree",
         lambda parser, data, seconds, old=None: fresh_parse(parser, data, seconds),
     )
@@ -492,10 +493,10 @@ def test_the_lines_captured_around_the_damage_do_not_change_the_facts(
     """Spellings are captured only near the damage, and the whole file is read again when a
     chosen region grows past that; with no or few lines of margin every file takes that path,
     and must come to the same facts."""
-    from archmetrics.parsers import c_family
+    from archmetrics.parsers import c_family_spellings
 
     usual = [facts_of(source, language) for language, source in _BRANCHY]
-    monkeypatch.setattr(c_family, "_CONTEXT_LINES", lines)
+    monkeypatch.setattr(c_family_spellings, "_CONTEXT_LINES", lines)
     assert [facts_of(source, language) for language, source in _BRANCHY] == usual
     assert all(facts.functions for facts in usual)
     # what a spelling of one branch sets aside is read from tokens, under a warning
