@@ -100,3 +100,15 @@ def test_no_import_circles(package: str) -> None:
     graph = grimp.build_graph(package, include_external_packages=False)
     imports = {m: set(graph.find_modules_directly_imported_by(m)) for m in graph.modules}
     assert _circles(imports) == []
+
+
+@pytest.mark.parametrize("package", ["archmetrics", "robosoa"])
+def test_no_module_is_over_400_lines(package: str) -> None:
+    """A module past 400 lines holds more than one room (docs/architecture.md): split it
+    along its seams."""
+    long = {
+        str(path.relative_to(ROOT)): lines
+        for path in sorted((ROOT / package).rglob("*.py"))
+        if (lines := len(path.read_text(encoding="utf-8").splitlines())) > 400
+    }
+    assert long == {}

@@ -28,7 +28,8 @@ from archmetrics.app.progress import NoProgress, Progress
 from archmetrics.changeset.files import exclusion, measured_files
 from archmetrics.changeset.rows import FileRow
 from archmetrics.changeset.state import TreeState, owners, patched_state, tree_state
-from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index, patch_index
+from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index
+from archmetrics.coupling.index_patch import patch_index
 from archmetrics.coupling.measure import link_tree
 from archmetrics.coupling.rostree import configures
 from archmetrics.facts import FileFacts

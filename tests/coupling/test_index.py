@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from archmetrics.coupling import CouplingOptions, measure_coupling
-from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index, patch_index
+from archmetrics.coupling.index import CouplingIndex, LazyFacts, build_index
+from archmetrics.coupling.index_patch import patch_index
 from archmetrics.coupling.measure import link_tree
 from archmetrics.coupling.sitememo import SiteMemo
 from archmetrics.facts import FileFacts
