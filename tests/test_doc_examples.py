@@ -29,6 +29,7 @@ def test_the_rule_pack_format_loads_and_its_rule_finds_its_example() -> None:
     pack = parse_pack(pack_block, "docs/metrics.md")
     [rule] = pack.rules
     [(language, snippet)] = rule.examples
+    assert language == "python"
     report = measure({"example.py": snippet}, rules=RuleSet((pack,)))
     sites = [s for s in report.of_file("example.py").link_sites if s.rule == rule.qualified_id]
     assert [s.endpoint.key if s.endpoint else None for s in sites] == [rule.example_endpoint]
