@@ -268,7 +268,7 @@ MAX_CONFIG_BYTES = 1 << 20
 """A configuration file larger than this (1 MiB) is refused rather than read."""
 
 
-def _read_document(path: Path) -> tuple[dict[str, Any], str]:
+def read_document(path: Path) -> tuple[dict[str, Any], str]:
     """The TOML document at ``path`` and its text; ConfigError for anything that is not
     one, however odd (a huge file, a FIFO or device, nesting deep enough to exhaust the
     parser's recursion, a bad encoding)."""
@@ -313,7 +313,7 @@ def load_settings(root: Path) -> Settings:
             continue
         if not _inside(root, path):
             raise ConfigError(f"{path}: a symbolic link leading out of the repository; not read")
-        document, text = _read_document(path)
+        document, text = read_document(path)
         tool = document.get("tool", {})
         if name == "pyproject.toml" and isinstance(tool, dict):
             notices += _near_misses(tool, path)

@@ -18,10 +18,10 @@ from archmetrics.config import (
     Settings,
     load_settings,
     parse_toml,
+    read_document,
     settings_from_document,
 )
 from archmetrics.globs import compile_glob
-from archmetrics.reading import TooLarge, read_regular
 from archmetrics.sources.checkout import Checkout
 from archmetrics.sources.snapshot import WORKTREE
 
@@ -85,15 +85,9 @@ def settings_from_file(
     ``pyproject.toml`` by that name (its ``[tool.archmetrics]``), else an
     ``archmetrics.toml``; its rule packs are read from the files on disk."""
     source = str(path)
-    try:
-        data = read_regular(path, MAX_CONFIG_BYTES)
-    except TooLarge:
-        raise ConfigError(f"{source}: larger than {MAX_CONFIG_BYTES} bytes; not read") from None
-    except OSError as error:
-        raise ConfigError(f"{source}: cannot read: {error.strerror or error}") from error
+    document, text = read_document(path)
     name = "pyproject.toml" if path.name == "pyproject.toml" else "archmetrics.toml"
-    text = data.decode("utf-8", "replace")
-    settings = settings_from_document(parse_toml(data, source), name, source, text)
+    settings = settings_from_document(document, name, source, text)
     if settings is None:
         raise ConfigError(f"{source}: no [tool.archmetrics] table")
     return merged(settings, exclude, allow_raised_limits)

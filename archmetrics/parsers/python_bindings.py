@@ -19,9 +19,9 @@ def _is_name(token: str) -> bool:
     return token.isidentifier()
 
 
-def assignment_bindings(kind: str, tokens: list[str]) -> list[tuple[str, str]]:
-    """(name, value text) of each plain name an ``assign``/``annassign`` statement binds,
-    the value's tokens joined by single spaces as statement texts are."""
+def _assignment_cuts(kind: str, tokens: list[str]) -> list[int]:
+    """The index of each top-level ``=`` of an ``assign``/``annassign`` statement (none for
+    another kind; one for an annotated one; none inside a lambda or brackets)."""
     if kind not in ("assign", "annassign"):
         return []
     cuts: list[int] = []
@@ -37,6 +37,13 @@ def assignment_bindings(kind: str, tokens: list[str]) -> list[tuple[str, str]]:
             cuts.append(index)
             if kind == "annassign":
                 break
+    return cuts
+
+
+def assignment_bindings(kind: str, tokens: list[str]) -> list[tuple[str, str]]:
+    """(name, value text) of each plain name an ``assign``/``annassign`` statement binds,
+    the value's tokens joined by single spaces as statement texts are."""
+    cuts = _assignment_cuts(kind, tokens)
     if not cuts:
         return []
     value = " ".join(tokens[cuts[-1] + 1 :])
@@ -74,20 +81,7 @@ def assignment_target(kind: str, tokens: list[str]) -> tuple[str, int, int] | No
     """For an ``assign``/``annassign`` statement whose last target is a dotted name
     (``x``, ``self.pub``): that target's text and the value's token range in ``tokens``
     (``[first, end)``, its outer parentheses and a ``;`` left out); None otherwise."""
-    if kind not in ("assign", "annassign"):
-        return None
-    depth, cuts = 0, []
-    for index, token in enumerate(tokens):
-        if token in _OPENERS:
-            depth += 1
-        elif token in _CLOSERS:
-            depth -= 1
-        elif depth == 0 and token == "lambda":
-            break
-        elif depth == 0 and token == "=":
-            cuts.append(index)
-            if kind == "annassign":
-                break
+    cuts = _assignment_cuts(kind, tokens)
     if not cuts:
         return None
     target = tokens[cuts[-2] + 1 if len(cuts) > 1 else 0 : cuts[-1]]
