@@ -225,11 +225,9 @@ def test_consumers_and_subscribers_refuse_frames_past_max_total(
     router.close(0)
 
 
-@pytest.mark.parametrize("curve", [False, True])
-def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) -> None:
-    """The guard's count of what was taken must keep up with what arrived: 150 requests and
-    200 one-way messages of 900 KiB (315 MB through one connection, 19 times its 16 MiB
-    budget), the one-way ones in bursts of four, none cut, with and without CURVE."""
+def steady_location(keys: Path, curve: bool) -> tuple[Proc, str, dict[str, object]]:
+    """A location service on loopback (CurveZMQ with ``curve``) and the bus options of the
+    steady-traffic tests: 1 MiB messages, the bus under test's keys."""
     secure = ["--curve-secret", str(keys / "location.key_secret"),
               "--curve-allow", str(keys / "allow")] if curve else []
     proc, url = start_location(f"tcp://127.0.0.1:{free_port()}",
@@ -238,6 +236,15 @@ def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) ->
     if curve:
         options |= {"curve_secret": str(keys / "alice.key_secret"),
                     "curve_allow": str(keys / "allow")}
+    return proc, url, options
+
+
+@pytest.mark.parametrize("curve", [False, True])
+def test_steady_traffic_near_the_budget_is_never_cut(keys: Path, curve: bool) -> None:
+    """The guard's count of what was taken must keep up with what arrived: 150 requests and
+    200 one-way messages of 900 KiB (315 MB through one connection, 19 times its 16 MiB
+    budget), the one-way ones in bursts of four, none cut, with and without CURVE."""
+    proc, url, options = steady_location(keys, curve)
     blob = b"y" * (900 * 1024)
     try:
         with robosoa.connect(url, **options) as provider, \

@@ -27,7 +27,7 @@ from robosoa.transports.zmq_guard import SUPPORTED
 from robosoa.transports.zmq_guard import budget as guard_budget
 from robosoa.transports.zmq_outlet import META
 from tests.robosoa.conftest import FAST
-from tests.robosoa.procs import PYTHON, Proc, free_port, start_location
+from tests.robosoa.procs import PYTHON, Proc
 from tests.robosoa.test_multipart_memory import (
     CAPPED,
     HEADROOM,
@@ -36,6 +36,7 @@ from tests.robosoa.test_multipart_memory import (
     cuts,
     peak,
     settled,
+    steady_location,
 )
 from tests.robosoa.util import eventually, raw_publisher
 
@@ -233,14 +234,7 @@ def test_steady_replies_and_broadcasts_near_the_budget_are_never_cut(keys: Path,
     with what arrives: 150 replies and 200 broadcasts of 900 KiB (135 MB and 180 MB through
     one connection each, 8 and 11 times its 16 MiB budget), broadcasts in bursts of four,
     none cut, with and without CURVE."""
-    secure = ["--curve-secret", str(keys / "location.key_secret"),
-              "--curve-allow", str(keys / "allow")] if curve else []
-    proc, url = start_location(f"tcp://127.0.0.1:{free_port()}",
-                               "--announce", f"tcp://127.0.0.1:{free_port()}", *secure)
-    options: dict[str, object] = {**FAST, "max_message": MIB}
-    if curve:
-        options |= {"curve_secret": str(keys / "alice.key_secret"),
-                    "curve_allow": str(keys / "allow")}
+    proc, url, options = steady_location(keys, curve)
     blob = b"y" * (900 * 1024)
     try:
         with robosoa.connect(url, **options) as provider, \
