@@ -187,8 +187,8 @@ def cold_warm(bench: Bench, name: str, checkout: Callable[[], Path], first: bool
     return lines
 
 
-def one_step(bench: Bench, name: str, repo: Path, commit: str) -> tuple[float, float, float]:
-    """``commit``'s step in a warm history (wall, CPU) and ``diff C^..C`` warm (wall)."""
+def one_step(bench: Bench, name: str, repo: Path, commit: str) -> tuple[float, ...]:
+    """``commit``'s step in a warm history and ``diff C^..C`` warm: wall and CPU of each."""
     cache, saved = bench.cache(f"{name}-one"), bench.cache(f"{name}-one-saved")
     remover(cache)()
     label = f"{name}.{commit[:10]}"
@@ -208,7 +208,7 @@ def one_step(bench: Bench, name: str, repo: Path, commit: str) -> tuple[float, f
         raise BenchError(f"{name}: history {commit} measured more than its one new commit")
     kept = bench.run(f"{label}.kept", history)
     warm = bench.run(f"{label}.diff-warm", diff)
-    return new.wall - kept.wall, new.cpu - kept.cpu, warm.wall
+    return new.wall - kept.wall, new.cpu - kept.cpu, warm.wall, warm.cpu
 
 
 def incremental(bench: Bench, name: str, checkout: Callable[[], Path], wanted: int) -> list[Line]:
@@ -219,11 +219,13 @@ def incremental(bench: Bench, name: str, checkout: Callable[[], Path], wanted: i
     if not picked:
         raise BenchError(f"{name}: no first-parent commit changes exactly one measured file")
     found = [one_step(bench, name, repo, commit) for commit in picked]
-    step, step_cpu, diff = (statistics.median(v) for v in zip(*found, strict=True))
+    step, step_cpu, diff, diff_cpu = (statistics.median(v) for v in zip(*found, strict=True))
     bench.found.setdefault("step_cpu", max(step_cpu, 1e-4))
     measure = f"one-file commit's step in a warm history, {name} ({len(picked)} commits)"
-    ours, peer = f"{step:.3f} / {step_cpu:.3f} s", f"diff C^..C warm: {diff:.3f} s"
-    note = "steps (wall s): " + ", ".join(f"{f[0]:.3f}" for f in found)
+    ours = f"{step:.3f} / {step_cpu:.3f} s"
+    peer = f"diff C^..C warm: {diff:.3f} / {diff_cpu:.3f} s"
+    note = f"CPU: {diff_cpu / max(step_cpu, 1e-4):.1f}x; steps (wall s): "
+    note += ", ".join(f"{f[0]:.3f}" for f in found)
     return [Line(measure, ours, peer, diff / max(step, 1e-4), "x", 10.0, note=note)]
 
 
