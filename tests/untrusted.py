@@ -1,9 +1,11 @@
-"""Helpers for tests that treat the measured repository as hostile: run the real CLI in a
-separate process and show that nothing outside the cache directory and ``--output`` changed."""
+"""Helpers for tests that treat the measured repository as hostile: run the real CLI (in a
+separate process, or in this one where the process boundary is not under test) and show that
+nothing outside the cache directory and ``--output`` changed."""
 
 from __future__ import annotations
 
 import hashlib
+import io
 import os
 import subprocess
 import sys
@@ -69,13 +71,22 @@ def checksums(root: Path) -> dict[str, tuple[str, int]]:
 def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = None) -> Run:
     """``archmetrics ARGV`` in this process (no interpreter to start: the security suite
     runs hundreds of commands), in ``cwd`` with the environment ``env`` added; what it
-    printed is captured."""
+    printed is captured as bytes and decoded as :func:`run_cli` decodes a process's output.
+
+    As in a process of its own: the exit code is what ``python -m archmetrics`` would exit
+    with, stdout and stderr are byte streams in the encoding ``PYTHONIOENCODING`` names
+    (UTF-8 otherwise) with the interpreter's error handlers (``strict`` on stdout,
+    ``backslashreplace`` on stderr), and the environment and working folder are restored
+    afterwards. Use :func:`run_cli` where the process itself is under test (a crash, a
+    signal, a resource limit, a wait that must be cut off)."""
     import contextlib
-    import io
 
     from archmetrics.cli import main
 
-    out, err = io.StringIO(), io.StringIO()
+    encoding = {**os.environ, **(env or {})}.get("PYTHONIOENCODING") or "utf-8"
+    name, _, errors = encoding.partition(":")
+    out = io.TextIOWrapper(io.BytesIO(), encoding=name, errors=errors or "strict")
+    err = io.TextIOWrapper(io.BytesIO(), encoding=name, errors="backslashreplace")
     saved = {key: os.environ.get(key) for key in env or {}}
     previous = os.getcwd()
     os.environ.update(env or {})
@@ -84,8 +95,8 @@ def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = Non
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 code = main(list(argv))
-            except SystemExit as exit:  # argparse's own usage errors
-                code = exit.code if isinstance(exit.code, int) else 2
+            except SystemExit as exit:  # argparse's own usage errors (2) and --help (0)
+                code = exit.code if isinstance(exit.code, int) else int(exit.code is not None)
     finally:
         os.chdir(previous)
         for key, value in saved.items():
@@ -93,4 +104,11 @@ def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = Non
                 os.environ.pop(key, None)
             else:
                 os.environ[key] = value
-    return Run(code, out.getvalue(), err.getvalue())
+    return Run(code, _written(out), _written(err))
+
+
+def _written(stream: io.TextIOWrapper) -> str:
+    stream.flush()
+    raw = stream.buffer
+    assert isinstance(raw, io.BytesIO)
+    return raw.getvalue().decode("utf-8", "backslashreplace")
