@@ -25,11 +25,11 @@ SOURCE = "def f(a):\n    if a:\n        return 1\n    return 2\n"
 TIMEOUT = 60
 
 
-def _one_line(argv: list[str], cwd: Path, problem: str) -> None:
+def _one_line(argv: list[str], cwd: Path, *problems: str) -> None:
     run = run_cli(argv, cwd, timeout=TIMEOUT)
     assert run.code == 2, run.err
     line = run.one_line_error()
-    assert problem in line, line
+    assert all(problem in line for problem in problems), line
 
 
 @pytest.fixture
@@ -40,8 +40,8 @@ def committed(repo: GitRepo) -> GitRepo:
 
 def test_a_fifo_plan_is_refused(committed: GitRepo) -> None:
     os.mkfifo(committed.root / "plan.toml")
-    _one_line(["estimate", "plan.toml"], committed.root, "plan.toml: cannot read: ")
-    _one_line(["estimate", "plan.toml"], committed.root, "a FIFO, not a regular file")
+    problems = ("plan.toml: cannot read: ", "a FIFO, not a regular file")
+    _one_line(["estimate", "plan.toml"], committed.root, *problems)
 
 
 def test_a_plan_linked_to_stdin_does_not_wait(committed: GitRepo, tmp_path: Path) -> None:
