@@ -4,11 +4,13 @@ nothing outside the cache directory and ``--output`` changed."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import os
 import subprocess
 import sys
+import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -79,8 +81,6 @@ def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = Non
     ``backslashreplace`` on stderr), and the environment and working folder are restored
     afterwards. Use :func:`run_cli` where the process itself is under test (a crash, a
     signal, a resource limit, a wait that must be cut off)."""
-    import contextlib
-
     from archmetrics.cli import main
 
     encoding = {**os.environ, **(env or {})}.get("PYTHONIOENCODING") or "utf-8"
@@ -105,6 +105,34 @@ def run_main(argv: Sequence[str], cwd: Path, env: Mapping[str, str] | None = Non
             else:
                 os.environ[key] = value
     return Run(code, _written(out), _written(err))
+
+
+def run_main_past_fifos(
+    argv: Sequence[str], cwd: Path, fifos: Sequence[Path], timeout: float = 60
+) -> Run:
+    """:func:`run_main` for a test of FIFOs that archmetrics must not wait on: a regression
+    would wait forever, and in this process that would hang the suite. So, once ``timeout``
+    seconds have passed (and every 0.1 s after that, until the run ends), each of ``fifos``
+    is opened for writing and closed again, which ends any reader's wait with an empty
+    read: the run finishes, and the test fails on what it printed, instead of hanging."""
+    ended = threading.Event()
+
+    def unblock() -> None:
+        if ended.wait(timeout):
+            return
+        while not ended.is_set():
+            for fifo in fifos:
+                with contextlib.suppress(OSError):  # ENXIO: nobody waits on it just now
+                    os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+            ended.wait(0.1)
+
+    watchdog = threading.Thread(target=unblock, daemon=True)
+    watchdog.start()
+    try:
+        return run_main(argv, cwd)
+    finally:
+        ended.set()
+        watchdog.join()
 
 
 def _written(stream: io.TextIOWrapper) -> str:

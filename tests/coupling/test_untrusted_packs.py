@@ -11,7 +11,7 @@ import pytest
 
 from archmetrics.coupling import patterns
 from tests.gitrepo import GitRepo
-from tests.untrusted import run_cli, run_main
+from tests.untrusted import run_cli, run_main_past_fifos
 
 pytestmark = pytest.mark.security
 
@@ -109,7 +109,7 @@ def test_a_configured_pack_that_cannot_be_trusted_is_refused(
     # a diff reads its base's configuration: EMPTY has none, so the head's is named
     # (rules loads the packs as scan does)
     diff = ["diff", "--base", "EMPTY", "--config-from", "head"]
-    for argv in (["scan", "."], diff):  # a FIFO read would wait: a process with a time limit
-        run = run_cli(argv, repo.root, timeout=60) if "fifo" in packs else run_main(argv, repo.root)
+    for argv in (["scan", "."], diff):  # a regression that waits on the FIFO fails in 60 s
+        run = run_main_past_fifos(argv, repo.root, [repo.root / "fifo.toml"])
         assert run.code == 2, (argv, run.err)
         assert problem in run.one_line_error()
