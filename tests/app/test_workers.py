@@ -15,7 +15,7 @@ import pytest
 
 from archmetrics.app.workers import Parsed, parse_in_workers
 from tests.gitrepo import GitRepo
-from tests.untrusted import run_cli
+from tests.untrusted import run_cli, run_main
 
 PLUGIN = """
 import ctypes, os, time
@@ -150,8 +150,9 @@ def test_files_cut_off_by_a_limit_are_not_cached(
 )
 @pytest.mark.security
 def test_limits_a_repository_sets_are_checked(repo: GitRepo, limits: str, problem: str) -> None:
+    """Refused while the configuration is read, before any worker starts: in process."""
     repo.commit("v1", files={"pyproject.toml": f"[tool.archmetrics.limits]\n{limits}\n"})
-    run = run_cli(["scan", "."], repo.root)
+    run = run_main(["scan", "."], repo.root)
     assert run.code == 2
     assert problem in run.one_line_error()
 
