@@ -30,6 +30,8 @@ def parse(path, source):
     if "ABORT" in source:
         os.abort()
     if "SLEEP" in source:
+        if os.environ.get("UNRULY_SLEEPING"):  # a file that says the sleep has begun
+            open(os.environ["UNRULY_SLEEPING"], "w").close()
         time.sleep(600)
     if "HOG" in source:
         hog = [bytearray(1 << 20) for _ in range(1 << 16)]
@@ -190,21 +192,22 @@ def _alive(pids: set[int]) -> set[int]:
 @pytest.mark.parametrize("fine", [3, 60], ids=["forked", "fork-server"])
 @pytest.mark.security
 def test_workers_exit_when_archmetrics_is_killed(
-    repo: GitRepo, plugin: dict[str, str], fine: int
+    repo: GitRepo, plugin: dict[str, str], fine: int, tmp_path: Path
 ) -> None:
     _repo(repo, {"slow.un": "# SLEEP\n"}, fine)
+    sleeping = tmp_path / "sleeping"
     process = subprocess.Popen(
         [sys.executable, "-m", "archmetrics", "scan", ".", "--no-cache", "-j", "2"],
         cwd=repo.root,
-        env={**os.environ, **plugin},
+        env={**os.environ, **plugin, "UNRULY_SLEEPING": str(sleeping)},
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
     try:
         deadline = time.monotonic() + 60
-        while len(workers := _descendants(process.pid)) < 2 and time.monotonic() < deadline:
-            time.sleep(0.1)
-        time.sleep(1.0)  # the slow file is being read now
+        while not sleeping.exists() and time.monotonic() < deadline:
+            time.sleep(0.01)  # until a worker is reading the slow file
+        assert sleeping.exists(), "no worker began to read the slow file"
         workers = _descendants(process.pid)
         assert workers
         os.kill(process.pid, signal.SIGKILL)
