@@ -15,7 +15,7 @@ import pytest
 
 from archmetrics.app.workers import Parsed, parse_in_workers
 from tests.gitrepo import GitRepo
-from tests.untrusted import run_cli
+from tests.untrusted import run_cli, run_main
 
 PLUGIN = """
 import ctypes, os, time
@@ -30,6 +30,8 @@ def parse(path, source):
     if "ABORT" in source:
         os.abort()
     if "SLEEP" in source:
+        if os.environ.get("UNRULY_SLEEPING"):  # a file that says the sleep has begun
+            open(os.environ["UNRULY_SLEEPING"], "w").close()
         time.sleep(600)
     if "HOG" in source:
         hog = [bytearray(1 << 20) for _ in range(1 << 16)]
@@ -150,8 +152,9 @@ def test_files_cut_off_by_a_limit_are_not_cached(
 )
 @pytest.mark.security
 def test_limits_a_repository_sets_are_checked(repo: GitRepo, limits: str, problem: str) -> None:
+    """Refused while the configuration is read, before any worker starts: in process."""
     repo.commit("v1", files={"pyproject.toml": f"[tool.archmetrics.limits]\n{limits}\n"})
-    run = run_cli(["scan", "."], repo.root)
+    run = run_main(["scan", "."], repo.root)
     assert run.code == 2
     assert problem in run.one_line_error()
 
@@ -189,21 +192,22 @@ def _alive(pids: set[int]) -> set[int]:
 @pytest.mark.parametrize("fine", [3, 60], ids=["forked", "fork-server"])
 @pytest.mark.security
 def test_workers_exit_when_archmetrics_is_killed(
-    repo: GitRepo, plugin: dict[str, str], fine: int
+    repo: GitRepo, plugin: dict[str, str], fine: int, tmp_path: Path
 ) -> None:
     _repo(repo, {"slow.un": "# SLEEP\n"}, fine)
+    sleeping = tmp_path / "sleeping"
     process = subprocess.Popen(
         [sys.executable, "-m", "archmetrics", "scan", ".", "--no-cache", "-j", "2"],
         cwd=repo.root,
-        env={**os.environ, **plugin},
+        env={**os.environ, **plugin, "UNRULY_SLEEPING": str(sleeping)},
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
     try:
         deadline = time.monotonic() + 60
-        while len(workers := _descendants(process.pid)) < 2 and time.monotonic() < deadline:
-            time.sleep(0.1)
-        time.sleep(1.0)  # the slow file is being read now
+        while not sleeping.exists() and time.monotonic() < deadline:
+            time.sleep(0.01)  # until a worker is reading the slow file
+        assert sleeping.exists(), "no worker began to read the slow file"
         workers = _descendants(process.pid)
         assert workers
         os.kill(process.pid, signal.SIGKILL)

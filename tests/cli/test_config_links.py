@@ -11,7 +11,7 @@ import pytest
 
 from archmetrics.cli import main
 from tests.gitrepo import GitRepo
-from tests.untrusted import checksums, run_cli
+from tests.untrusted import checksums, run_main
 
 ONE_ROUTE = """[[rules]]
 operation = "drive"
@@ -117,7 +117,7 @@ def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
     (repo.root / "linked" / "rules.toml").symlink_to(outside)
     repo.commit("v1", files={"broken/rules.toml": "[[rules]\nto = [\n", "a.py": "x = 1\n"})
     before = checksums(tmp_path)
-    done = run_cli(["scan", "--by", "link", "--no-cache", "--format", "json", "."], repo.root)
+    done = run_main(["scan", "--by", "link", "--no-cache", "--format", "json", "."], repo.root)
     assert done.code == 0, done.err
     files = {f["path"]: f for f in json.loads(done.out)["files"]}
     assert set(files) == {"a.py", "broken/rules.toml"}  # the link is skipped, like any link
@@ -130,7 +130,7 @@ def test_a_linked_rules_file_is_not_followed_and_a_broken_one_is_reported(
 def test_a_huge_rules_file_is_over_the_file_limit_not_read(tmp_path: Path) -> None:
     (tmp_path / "pyproject.toml").write_text("[tool.archmetrics.limits]\nfile-mb = 0.01\n")
     (tmp_path / "rules.toml").write_text(ONE_ROUTE + '\n[[rules]]\nx = "y"\n' * 2_000)
-    done = run_cli(["scan", "--no-cache", "--format", "json", "."], tmp_path)
+    done = run_main(["scan", "--no-cache", "--format", "json", "."], tmp_path)
     assert done.code == 0, done.err
     [facts] = json.loads(done.out)["files"]
     assert facts["parsed"] is False and "limit" in facts["warnings"][0]["message"]
@@ -146,7 +146,7 @@ def test_a_configured_pack_with_a_bad_glob_is_one_line_naming_the_key(tmp_path: 
     (tmp_path / "pyproject.toml").write_text(
         '[tool.archmetrics.coupling]\nrule-packs = ["pack.toml"]\n'
     )
-    done = run_cli(["scan", "--no-cache", "."], tmp_path)
+    done = run_main(["scan", "--no-cache", "."], tmp_path)
     assert done.code == 2
     line = done.one_line_error()
     assert "pack.toml" in line and "rule 'r'" in line and "key 'files'" in line

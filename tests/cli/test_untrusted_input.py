@@ -61,7 +61,10 @@ def test_an_unforeseen_error_is_one_line_and_v_shows_the_traceback(
     repo: GitRepo, tmp_path: Path
 ) -> None:
     """A broken language plugin (its entry point is not a LanguageSpec) is nothing the CLI
-    knows how to explain: still exit 2 and one line, and -v prints the traceback."""
+    knows how to explain: still exit 2 and one line, and -v prints the traceback.
+
+    Processes of their own: PYTHONPATH, which brings the plugin in, is read when the
+    interpreter starts."""
     site = tmp_path / "site"
     (site / "broken-1.0.dist-info").mkdir(parents=True)
     (site / "broken_lang.py").write_text("SPEC = 42\n")
@@ -120,7 +123,7 @@ def test_json_bytes_are_valid_utf8_and_diff_pairs_escaped_names(repo: GitRepo) -
     name = os.fsdecode(NAMES["latin1"])
     repo.commit("v1", files={name: SOURCE})
     repo.write({name: SOURCE + "\n\ndef g(b):\n    return b or 1\n"})
-    run = run_cli(["diff", "--format", "json", "--no-cache"], repo.root)
+    run = run_main(["diff", "--format", "json", "--no-cache"], repo.root)
     assert run.code == 0, run.err
     document = json.loads(run.out.encode("utf-8"))
     total = document["locations"]["total"]
@@ -135,8 +138,8 @@ def test_json_bytes_are_valid_utf8_and_diff_pairs_escaped_names(repo: GitRepo) -
 def test_every_format_prints_on_a_narrow_encoding(repo: GitRepo, encoding: str, fmt: str) -> None:
     repo.commit("v1", tag="v1", files={"a.py": SOURCE})
     repo.commit("v2", files={"a.py": SOURCE + "x = 1\n"})
-    env = {"PYTHONIOENCODING": encoding}
+    env = {"PYTHONIOENCODING": encoding}  # run_main's stdout is then in that encoding
     for argv in (["diff", "--base", "v1", "--head", "HEAD"], ["scan", "."]):
-        run = run_cli([*argv, "--format", fmt], repo.root, env)
+        run = run_main([*argv, "--format", fmt], repo.root, env)
         assert run.code == 0, run.err
         assert run.out.strip()

@@ -3,7 +3,9 @@ or a full disk — must not leave a cache that makes the next run fail or report
 (docs/security.md, threat table; "The facts cache").
 
 The disk is made "full" with ``RLIMIT_FSIZE`` (and ``SIGXFSZ`` ignored, so a write fails with
-``EFBIG`` as it would with ``ENOSPC``)."""
+``EFBIG`` as it would with ``ENOSPC``). The run that is killed or runs out of disk is a process
+of its own; the runs before and after it, whose output is compared, run in this one
+(tests/untrusted.py ``run_main``)."""
 
 from __future__ import annotations
 
@@ -19,25 +21,35 @@ from pathlib import Path
 import pytest
 
 from tests.gitrepo import GitRepo
-from tests.untrusted import run_cli
+from tests.untrusted import run_main
 
 pytestmark = pytest.mark.security
 
 FILES = {
-    f"pkg/m{k:03d}.py": "".join(f"def f{j}(a):\n    if a > {j}:\n        return a\n    return {j}\n"
+    f"pkg/m{k:03d}.py": "".join(f"def f{j}(a):\n    if a > {j}:\n        return a\n    return {k}\n"
                                 for j in range(30))
-    for k in range(80)
+    for k in range(10)
 }  # fmt: skip
+"""Ten files, each of its own content (git stores, and the cache keeps, one copy of equal
+contents): their facts take the cache past 100 KB, over the 64 KB of the "full disk"."""
 
 
-@pytest.fixture
-def many(repo: GitRepo) -> GitRepo:
+@pytest.fixture(scope="module")
+def many(tmp_path_factory: pytest.TempPathFactory) -> GitRepo:
+    """The repository every run here only reads (each has a cache of its own)."""
+    repo = GitRepo(tmp_path_factory.mktemp("interrupted") / "repo")
     repo.commit("v1", files=FILES)
     return repo
 
 
+@pytest.fixture(scope="module")
+def expected(many: GitRepo) -> object:
+    """The report measured without a cache."""
+    return json.loads(_scan(many, "--no-cache")[1])
+
+
 def _scan(repo: GitRepo, *extra: str) -> tuple[int, str, str]:
-    run = run_cli(["scan", ".", "--format", "json", *extra], repo.root)
+    run = run_main(["scan", ".", "--format", "json", *extra], repo.root)
     return run.code, run.out, run.err
 
 
@@ -46,24 +58,40 @@ def _consistent(cache: Path) -> None:
         assert db.execute("PRAGMA integrity_check").fetchone() == ("ok",)
 
 
-def test_a_run_killed_while_caching_leaves_a_cache_the_next_run_trusts(
-    many: GitRepo, tmp_path: Path
-) -> None:
-    expected = json.loads(_scan(many, "--no-cache")[1])
-    cache = tmp_path / "facts.sqlite3"
-    for delay in (0.5, 2.0):  # killed earlier or later in the run: the same must hold
-        started = subprocess.Popen(
-            [sys.executable, "-m", "archmetrics", "scan", ".", "--cache-path", str(cache)],
-            cwd=many.root, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        )  # fmt: skip
-        time.sleep(delay)
+def _kill_when_it_appears(repo: GitRepo, cache: Path, watched: Path) -> None:
+    """Start a caching scan and SIGKILL it as soon as ``watched`` exists (polled every
+    millisecond, for at most a minute): the run must still be going when it is killed."""
+    assert not watched.exists()
+    started = subprocess.Popen(
+        [sys.executable, "-m", "archmetrics", "scan", ".", "--cache-path", str(cache)],
+        cwd=repo.root, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while not watched.exists() and time.monotonic() < deadline:
+            assert started.poll() is None, f"the run ended before {watched.name} appeared"
+            time.sleep(0.001)
+        assert started.poll() is None, "the run ended before it was killed"
         started.send_signal(signal.SIGKILL)
+    finally:
+        started.kill()
         started.wait(timeout=60)
-        code, out, err = _scan(many, "--cache-path", str(cache))
-        assert code == 0, err
-        assert json.loads(out) == expected
-        if cache.exists():
-            _consistent(cache)
+    assert started.returncode == -signal.SIGKILL
+
+
+@pytest.mark.parametrize("moment", ["created", "-journal"])
+def test_a_run_killed_while_caching_leaves_a_cache_the_next_run_trusts(
+    many: GitRepo, expected: object, tmp_path: Path, moment: str
+) -> None:
+    """Killed as soon as the cache file is created, or in its first write transaction
+    (SQLite's rollback journal is there): the next run must measure the same."""
+    cache = tmp_path / "facts.sqlite3"
+    watched = cache if moment == "created" else cache.with_name(cache.name + moment)
+    _kill_when_it_appears(many, cache, watched)
+    code, out, err = _scan(many, "--cache-path", str(cache))
+    assert code == 0, err
+    assert json.loads(out) == expected
+    _consistent(cache)
 
 
 def _full_disk() -> None:
@@ -72,9 +100,8 @@ def _full_disk() -> None:
 
 
 def test_a_full_disk_is_one_line_and_leaves_the_cache_usable(
-    many: GitRepo, tmp_path: Path
+    many: GitRepo, expected: object, tmp_path: Path
 ) -> None:
-    expected = json.loads(_scan(many, "--no-cache")[1])
     cache = tmp_path / "facts.sqlite3"
     done = subprocess.run(
         [sys.executable, "-m", "archmetrics", "scan", ".", "--format", "json",

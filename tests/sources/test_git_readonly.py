@@ -1,8 +1,13 @@
-"""Reading a repository never writes to it, never fetches, and explains what it cannot read."""
+"""Reading a repository never writes to it, never fetches, and explains what it cannot read.
+
+The CLI runs in this process (tests/untrusted.py ``run_main``): what is under test is the
+files under the work tree and ``.git``, which the git processes archmetrics starts would
+change the same way either way."""
 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import time
 from pathlib import Path
@@ -10,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from tests.gitrepo import _ENV, GitRepo
-from tests.untrusted import checksums, run_cli
+from tests.untrusted import checksums, run_main
 
 pytestmark = pytest.mark.security
 
@@ -32,6 +37,23 @@ def _history(repo: GitRepo) -> None:
         os.utime(path, (past, past))
 
 
+@pytest.fixture(scope="module")
+def made_history(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """:func:`_history` made once per module (a dozen git commands)."""
+    repo = GitRepo(tmp_path_factory.mktemp("readonly") / "repo")
+    _history(repo)
+    return repo.root
+
+
+@pytest.fixture
+def history(made_history: Path, tmp_path: Path) -> Path:
+    """A copy of :func:`_history` of the test's own, the stale stat data included (a copied
+    file keeps its modification time; its inode and change time differ from the index's)."""
+    root = tmp_path / "repo"
+    shutil.copytree(made_history, root, symlinks=True)
+    return root
+
+
 @pytest.mark.parametrize(
     "argv",
     [
@@ -50,38 +72,35 @@ def _history(repo: GitRepo) -> None:
     ids=lambda argv: "-".join(argv),
 )
 def test_measuring_changes_no_file_under_the_work_tree_or_git(
-    repo: GitRepo, argv: list[str]
+    history: Path, argv: list[str]
 ) -> None:
-    _history(repo)
-    before = checksums(repo.root)
-    run = run_cli([*argv, "--no-cache"] if argv[0] != "graph" else argv, repo.root)
+    before = checksums(history)
+    run = run_main([*argv, "--no-cache"] if argv[0] != "graph" else argv, history)
     assert run.code == 0, run.err
-    assert checksums(repo.root) == before
+    assert checksums(history) == before
 
 
 @pytest.mark.parametrize("head", ["WORKTREE", "INDEX", "v2"])
 def test_a_diff_patching_a_kept_state_changes_no_file(
-    repo: GitRepo, tmp_path: Path, head: str
+    history: Path, tmp_path: Path, head: str
 ) -> None:
     """The incremental path (a cache, a base commit's kept state, git asked what differs)
     writes nothing under the work tree or .git either, stale index stat data included."""
-    _history(repo)
     cache = ["--cache-path", str(tmp_path / "cache.sqlite3")]
-    before = checksums(repo.root)
+    before = checksums(history)
     for _ in range(2):  # the base's state kept, then patched
-        run = run_cli(["diff", "--base", "v1", "--head", head, *cache], repo.root)
+        run = run_main(["diff", "--base", "v1", "--head", head, *cache], history)
         assert run.code == 0, run.err
-    assert checksums(repo.root) == before
+    assert checksums(history) == before
 
 
-def test_a_diff_works_while_another_git_holds_the_index_lock(repo: GitRepo) -> None:
-    _history(repo)
-    lock = repo.root / ".git" / "index.lock"
+def test_a_diff_works_while_another_git_holds_the_index_lock(history: Path) -> None:
+    lock = history / ".git" / "index.lock"
     lock.write_bytes(b"held by a concurrent git commit")
-    before = checksums(repo.root)
-    run = run_cli(["diff", "--format", "json"], repo.root)
+    before = checksums(history)
+    run = run_main(["diff", "--format", "json"], history)
     assert run.code == 0, run.err
-    assert checksums(repo.root) == before
+    assert checksums(history) == before
 
 
 def _clone(source: GitRepo, dest: Path, *options: str) -> Path:
@@ -100,7 +119,7 @@ def test_a_partial_clone_is_not_fetched_into(repo: GitRepo, tmp_path: Path) -> N
     repo.commit("two", tag="v2", files={"a.py": V2})
     clone = _clone(repo, tmp_path / "partial", "--filter=blob:none", "--no-checkout")
     before = checksums(clone)
-    run = run_cli(["diff", "--base", "v1", "--head", "v2", "--no-cache"], clone)
+    run = run_main(["diff", "--base", "v1", "--head", "v2", "--no-cache"], clone)
     assert run.code == 2
     assert "partial clone" in run.one_line_error()
     assert checksums(clone) == before
@@ -113,11 +132,11 @@ def test_a_revision_beyond_a_shallow_clone_says_how_to_fetch_it(
     repo.commit("two", files={"a.py": V2})
     clone = _clone(repo, tmp_path / "shallow", "--depth", "1")
     before = checksums(clone)
-    run = run_cli(["diff", "--base", "HEAD~1", "--head", "HEAD"], clone)
+    run = run_main(["diff", "--base", "HEAD~1", "--head", "HEAD"], clone)
     assert run.code == 2
     assert "git fetch --unshallow" in run.one_line_error()
     assert checksums(clone) == before
-    assert run_cli(["diff", "--base", "HEAD", "--head", "HEAD"], clone).code == 0
+    assert run_main(["diff", "--base", "HEAD", "--head", "HEAD"], clone).code == 0
 
 
 def test_reflog_and_previous_branch_syntax(repo: GitRepo) -> None:
@@ -125,12 +144,12 @@ def test_reflog_and_previous_branch_syntax(repo: GitRepo) -> None:
     repo.git("checkout", "-q", "-b", "topic")
     repo.commit("two", files={"a.py": V2})
     repo.git("checkout", "-q", "main")
-    run = run_cli(["diff", "--base", "HEAD", "--head", "@{-1}", "--format", "json"], repo.root)
+    run = run_main(["diff", "--base", "HEAD", "--head", "@{-1}", "--format", "json"], repo.root)
     assert run.code == 0, run.err
     assert '"added"' in run.out
-    assert run_cli(["diff", "--base", "topic@{1}", "--head", "topic"], repo.root).code == 0
+    assert run_main(["diff", "--base", "topic@{1}", "--head", "topic"], repo.root).code == 0
     for bad in ("@{-9}", "HEAD@{99}", "--output=x", "HEAD:a.py", "nope^{tree}"):
-        run = run_cli(["diff", f"--base={bad}"], repo.root)
+        run = run_main(["diff", f"--base={bad}"], repo.root)
         assert run.code == 2
         assert f"unknown revision {bad!r}" in run.one_line_error()
     assert not (repo.root / "x").exists()
@@ -143,6 +162,6 @@ def test_a_repository_owned_by_another_user(repo: GitRepo, tmp_path: Path) -> No
     home = tmp_path / "home"
     home.mkdir()
     for argv in (["diff"], ["scan", "."], ["diff", "--base", "HEAD", "--head", "HEAD"]):
-        run = run_cli(argv, repo.root, {"HOME": str(home), "GIT_CONFIG_NOSYSTEM": "1"})
+        run = run_main(argv, repo.root, {"HOME": str(home), "GIT_CONFIG_NOSYSTEM": "1"})
         assert run.code == 2
         assert "safe.directory" in run.one_line_error()
