@@ -54,12 +54,14 @@ def parse(
 
 _CPLUSPLUS = rb"#[ \t]*if(?:def[ \t]+__cplusplus|[ \t]+defined[ \t(]*__cplusplus[ \t)]*)[^\n]*\n"
 _EXTERN_C_GUARD = re.compile(
-    rb"(" + _CPLUSPLUS + rb")([ \t]*(?:extern[ \t]+\"C\"[ \t]*)?[{}][ \t]*)(?=\n[ \t]*#[ \t]*endif)"
+    rb"(" + _CPLUSPLUS + rb")([ \t]*(?:extern[ \t]+\"C\"[ \t]*)?[{}][ \t]*"
+    rb"(?:/\*(?:[^*\n]|\*(?!/))*\*/[ \t]*|//[^\n]*)?)(?=\n[ \t]*#[ \t]*endif)"
 )
 
 
 def hide_extern_c_guards(data: bytes) -> bytes:
-    """Blank the ``extern "C" {`` and ``}`` lines that sit alone inside ``#ifdef __cplusplus``.
+    """Blank the ``extern "C" {`` and ``}`` lines that sit alone inside ``#ifdef __cplusplus``
+    (with a comment after them or not: ``}  /* extern "C" */``).
 
     The idiom opens a brace in one preprocessor branch and closes it in another, which no
     grammar of the unpreprocessed text can follow (tree-sitter reports a missing ``#endif``).

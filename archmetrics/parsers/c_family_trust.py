@@ -189,6 +189,7 @@ def reconcile(
 
     kept: list[FunctionSlot] = []
     pairs: dict[int, TokenFunction] = {}
+    function_starts = sorted(function.start for function in functions)
     for at, slot in enumerate(slots):
         area = area_of(slot.start, slot.end)
         keyword = slot.name.encode() in KEYWORDS
@@ -197,7 +198,7 @@ def reconcile(
         elif at in matched and not keyword:
             token = functions[matched[at]]
             if area is not None:
-                _adopt_head(slot, token, area, functions, lines)
+                _adopt_head(slot, token, area, function_starts, (data, lines))
             kept.append(slot)
             pairs[id(slot)] = token
         elif not keyword and slot.name not in macros and not _replaced(slot, functions):
@@ -223,21 +224,42 @@ def _adopt_head(
     slot: FunctionSlot,
     token: TokenFunction,
     area: Area,
-    functions: list[TokenFunction],
-    lines: Lines,
+    function_starts: list[int],
+    text: tuple[bytes, Lines],
 ) -> None:
     """Where the tree misread a function's head, the token reading's: its name, when the
     tree named it after a macro before it (``GENERATE_TEST(a) ... int main(void) {``),
     and its start, when the tree's head holds other functions (a class read as the head
-    of the function after its methods)."""
-    renamed = not slot.name.startswith(token.name)
-    swallowed = any(slot.start <= f.start < token.start for f in functions if f is not token)
+    of the function after its methods). ``function_starts``: those of the token reading's
+    functions, sorted. The tree's name is kept when it stands after the token reading's,
+    nearer the body (``f(p) int *p; extern void g(int*); void f(int *p)`` across #if
+    branches: the tree's ``f``, not the declared ``g``). Names that differ only in spaces
+    (``operator Matcher< C>``) are one name."""
+    data, lines = text
+    renamed = not _spaceless(slot.name).startswith(_spaceless(token.name))
+    renamed = renamed and token.name_at > _last_word(data, slot.name, slot.start, slot.body_start)
+    swallowed = bisect.bisect_left(function_starts, token.start) > bisect.bisect_left(
+        function_starts, slot.start
+    )
     if renamed:
         area.renamed.append((slot.qualified, token.qualified))
         slot.name, slot.qualified = token.name, token.qualified
     if renamed or swallowed:
         slot.span = Span(min(lines.of(token.start), slot.span.end), slot.span.end)
         slot.start = max(slot.start, token.start)
+
+
+def _spaceless(name: str) -> str:
+    """``name`` without its spaces: ``operator Matcher< C>`` is ``operator Matcher<C>``."""
+    return name.replace(" ", "")
+
+
+def _last_word(data: bytes, word: str, start: int, end: int) -> int:
+    """Where ``word`` stands last, as a whole word, in ``data[start:end]`` (-1: nowhere)."""
+    found = -1
+    for match in re.finditer(rb"\b" + re.escape(word.encode()) + rb"\b", data[start:end]):
+        found = start + match.start()
+    return found
 
 
 def _area_for(areas: list[Area], slot: FunctionSlot) -> Area:

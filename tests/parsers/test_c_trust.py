@@ -520,6 +520,49 @@ def test_macro_calls_before_a_function_head_do_not_name_it() -> None:
     ]
 
 
+def test_a_declaration_in_another_if_branch_does_not_name_the_function() -> None:
+    # f2c.c's pow_zi: a K&R head in one #if branch, a declaration and the prototype head in
+    # the other; the token reading, reading both branches' tokens, named the function after
+    # the declared `twice`, and the tree's right name was replaced by it
+    facts = c(
+        """\
+        #ifdef KR_headers
+        void power(p, b)
+         int *p; int b;
+        #else
+        extern void twice(int *);
+        void power(int *p, int b)
+        #endif
+        {
+        \tif (b > 0)
+        \t\ttwice(p);
+        }
+        """
+    )
+    assert [(f.name, f.span.end, f.complexity) for f in facts.functions] == [("power", 11, 2)]
+    assert not any("read as" in message for message in messages(facts))
+
+
+def test_an_operator_named_with_other_spaces_is_not_renamed() -> None:
+    # gmock's matchers: a damaged typedef in the body of `operator Matcher<Container>()`; the
+    # token reading spells the name `operator Matcher< Container>`, the same name
+    facts = cpp(
+        """\
+        class Holder {
+         public:
+          template <typename Container>
+          // a comment
+          operator Matcher<Container>() const {
+            typedef REMOVE_CONST_(Container) Raw;
+            return Matcher<Container>(value_);
+          }
+        };
+        """
+    )
+    assert functions(facts) == {"Holder::operator Matcher<Container>": (5, 8, 1, False)}
+    assert messages(facts) == []
+
+
 RULE_MACROS = """\
 #define RULE(x)
 #define RULEX(x)

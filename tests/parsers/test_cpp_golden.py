@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import textwrap
+
 import pytest
 
-from archmetrics.facts import FileFacts, Span
+from archmetrics.facts import FileFacts, Language, Span
+from archmetrics.parsers import c_family
 from tests.harness import complexities, facts_of, statement_kinds
 
 
@@ -426,3 +429,26 @@ def test_extern_c_guard_idiom_parses_cleanly_and_counts_nothing(language: str) -
     facts = facts_of(source, language, "api.h")
     assert facts.warnings == ()
     assert [(s.kind, s.span.start) for s in facts.statements] == [("declaration", 6)]
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_extern_c_guard_idiom_with_comments_after_its_braces_is_hidden_too(language: str) -> None:
+    # protobuf's upb headers close the block as `}  /* extern "C" */`: tree-sitter sees a
+    # `}` that closes nothing unless those lines are blanked like the bare idiom's
+    source = """\
+        #ifdef __cplusplus
+        extern "C" {  // C linkage
+        #endif
+        int api_open(const char *name);
+        #ifdef __cplusplus
+        }  /* extern "C" */
+        #endif
+        """
+    data = c_family.hide_extern_c_guards(textwrap.dedent(source).encode())
+    lines = data.decode().splitlines()
+    assert (lines[1].strip(), lines[5].strip()) == ("", "")
+    assert not c_family.grammar(Language(language)).parser.parse(data).root_node.has_error
+    facts = facts_of(source, language, "api.h")
+    # 7 lines, the two blanked ones not source lines
+    assert (facts.sloc, facts.warnings) == (5, ())
+    assert [(s.kind, s.span.start) for s in facts.statements] == [("declaration", 4)]
