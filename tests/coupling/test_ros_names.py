@@ -1,0 +1,82 @@
+"""ROS sites named from elsewhere in their package: the node of the program making a class,
+a member set from a parameter default outside the constructor (docs/metrics.md, "Names, as
+ROS resolves them"). Real files through the real parsers and the shipped packs; every
+expected name worked out by hand from the snippets."""
+
+from __future__ import annotations
+
+from tests.coupling.test_ros import ros, site_at
+
+PACKAGE = "<package><name>mover</name></package>\n"
+
+MOVER_HEADER = """\
+#include <ros/ros.h>
+namespace mover {
+class Mover {
+ public:
+  Mover();
+  void tick();
+ private:
+  ros::Publisher goal_pub_;
+};
+}
+"""
+
+MOVER = """\
+#include "mover/mover.h"
+namespace mover {
+Mover::Mover() {
+  ros::NodeHandle private_nh("~");
+  goal_pub_ = private_nh.advertise<geometry_msgs::PoseStamped>("current_goal", 1);
+}
+void Mover::tick() { goal_pub_.publish(goal_); }
+}
+"""
+
+MAIN = """\
+#include "mover/mover.h"
+int main(int argc, char ** argv) {
+  ros::init(argc, argv, "mover_node");
+  mover::Mover mover;
+  ros::spin();
+  return 0;
+}
+"""
+
+
+def _mover(**more: str) -> dict[str, str]:
+    return {
+        "mover/package.xml": PACKAGE,
+        "mover/include/mover/mover.h": MOVER_HEADER,
+        "mover/src/mover.cpp": MOVER,
+        **more,
+    }
+
+
+def test_a_class_takes_the_node_of_the_program_making_it_in_its_package() -> None:
+    report = ros(_mover(**{"mover/src/mover_node.cpp": MAIN}))
+    # ~current_goal on a "~" handle, in the node ros::init names in mover_node.cpp
+    made = site_at(report, "mover/src/mover.cpp", 5)
+    published = site_at(report, "mover/src/mover.cpp", 7)
+    assert made.endpoint is not None and made.endpoint.key == "topic:/mover_node/current_goal"
+    assert published.endpoint is not None
+    assert published.endpoint.key == "topic:/mover_node/current_goal"
+    assert made.node == "/mover_node"
+    assert "mover/src/mover_node.cpp:4" in made.note
+
+
+def test_a_class_made_under_two_nodes_or_none_keeps_its_private_names_unresolved() -> None:
+    other = MAIN.replace("mover_node", "other_node")
+    report = ros(_mover(**{"mover/src/mover_node.cpp": MAIN, "mover/src/other.cpp": other}))
+    made = site_at(report, "mover/src/mover.cpp", 5)
+    assert made.endpoint is None and "not known statically" in made.note
+    alone = ros(_mover())  # no program makes the class
+    assert site_at(alone, "mover/src/mover.cpp", 5).endpoint is None
+
+
+def test_a_plugin_class_keeps_its_loaders_node_unknown() -> None:
+    exported = MOVER + "PLUGINLIB_EXPORT_CLASS(mover::Mover, nav_core::RecoveryBehavior)\n"
+    exported = "#include <pluginlib/class_list_macros.h>\n" + exported
+    report = ros(_mover(**{"mover/src/mover.cpp": exported, "mover/src/mover_node.cpp": MAIN}))
+    made = site_at(report, "mover/src/mover.cpp", 6)  # one line lower: the include
+    assert made.endpoint is None and "not known statically" in made.note
