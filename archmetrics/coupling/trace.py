@@ -229,7 +229,7 @@ class Tracer:
 
     def _wrapped(self, text: str, function: str | None, line: int, depth: int) -> Value | None:
         """An argument written as a call a value rule knows: ``rclcpp::ParameterValue("x")``."""
-        if self.values is None or depth <= 0 or "(" not in text:
+        if self.values is None or depth <= 0 or ("(" not in text and "{" not in text):
             return None
         found = self.values.wrapped(text)
         if found is None:

@@ -80,3 +80,30 @@ def test_a_plugin_class_keeps_its_loaders_node_unknown() -> None:
     report = ros(_mover(**{"mover/src/mover.cpp": exported, "mover/src/mover_node.cpp": MAIN}))
     made = site_at(report, "mover/src/mover.cpp", 6)  # one line lower: the include
     assert made.endpoint is None and "not known statically" in made.note
+
+
+SERVER = """\
+#include "nav2_ros_common/lifecycle_node.hpp"
+#include <nav_msgs/msg/occupancy_grid.hpp>
+namespace vo {
+Server::Server(const rclcpp::NodeOptions & options)
+: nav2::LifecycleNode("vo_server", "", options) {}
+nav2::CallbackReturn Server::on_configure(const rclcpp_lifecycle::State & state) {
+  obtainParams();
+  map_pub_ = create_publisher<nav_msgs::msg::OccupancyGrid>(map_topic_, 1);
+  return nav2::CallbackReturn::SUCCESS;
+}
+void Server::obtainParams() {
+  auto node = shared_from_this();
+  map_topic_ = nav2::declare_or_get_parameter(node, "map_topic", std::string{"vo_map"});
+}
+}
+"""
+
+
+def test_a_member_set_from_a_braced_parameter_default_in_another_method_names_the_site() -> None:
+    files = {"vo/package.xml": "<package><name>vo</name></package>\n", "vo/src/server.cpp": SERVER}
+    made = site_at(ros(files), "vo/src/server.cpp", 8)
+    # map_topic_ = the default "vo_map" of map_topic (obtainParams), relative: /vo_map
+    assert made.endpoint is not None
+    assert (made.endpoint.key, made.endpoint.via) == ("topic:/vo_map", "parameter:map_topic")
