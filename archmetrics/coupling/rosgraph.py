@@ -219,7 +219,7 @@ def _renamed(site: LinkSite, tree: RosTree, configuration: _Configuration) -> Li
     name = (entry.name if entry and entry.name else own) or None
     where = entry.namespace if entry and entry.namespace else namespace
     node = NodeName(name, clean_namespace(where))
-    if site.parameter and node.fully_qualified:
+    if site.parameter and node.fully_qualified and not configuration.note:  # agreed, or none
         values = tree.values_for(node.fully_qualified, site.parameter)
         if entry is not None:
             values |= {v for k, v in entry.parameters if k == site.parameter}

@@ -107,3 +107,25 @@ def test_a_member_set_from_a_braced_parameter_default_in_another_method_names_th
     # map_topic_ = the default "vo_map" of map_topic (obtainParams), relative: /vo_map
     assert made.endpoint is not None
     assert (made.endpoint.key, made.endpoint.via) == ("topic:/vo_map", "parameter:map_topic")
+
+
+def test_launch_files_that_disagree_leave_the_declared_default_not_a_parameter_file() -> None:
+    from tests.coupling.test_ros import LAUNCH, PARAMS, WORKSPACE
+
+    other = LAUNCH.replace("robot1", "robot2")
+    files = {
+        **WORKSPACE,
+        "talker_pkg/config/talker_params.yaml": PARAMS,  # talker: topic: news
+        "bringup/package.xml": "<package><name>bringup</name></package>\n",
+        "bringup/launch/one.launch.py": LAUNCH,
+        "bringup/launch/two.launch.py": other,
+    }
+    report = ros(files)
+    # talker.cpp line 8: create_publisher(topic_), topic_ declared with the default "chatter";
+    # the node runs as /robot1/talker and /robot2/talker: the code's names, the default's
+    publisher = site_at(report, "talker_pkg/src/talker.cpp", 8)
+    assert publisher.endpoint is not None and publisher.endpoint.key == "topic:/chatter"
+    assert "started differently by launch files" in publisher.note
+    # started by no launch file, the parameter file naming the node sets the name (news)
+    alone = ros({**WORKSPACE, "talker_pkg/config/talker_params.yaml": PARAMS})
+    assert site_at(alone, "talker_pkg/src/talker.cpp", 8).endpoint.key == "topic:/news"
