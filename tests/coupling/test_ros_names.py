@@ -129,3 +129,35 @@ def test_launch_files_that_disagree_leave_the_declared_default_not_a_parameter_f
     # started by no launch file, the parameter file naming the node sets the name (news)
     alone = ros({**WORKSPACE, "talker_pkg/config/talker_params.yaml": PARAMS})
     assert site_at(alone, "talker_pkg/src/talker.cpp", 8).endpoint.key == "topic:/news"
+
+
+SLOW = """\
+#include <ros/ros.h>
+#include <dynamic_reconfigure/Reconfigure.h>
+int main(int argc, char ** argv) {
+  ros::init(argc, argv, "slow");
+  ros::NodeHandle private_nh("~");
+  std::string planner_namespace;
+  private_nh.param("planner_namespace", planner_namespace, std::string("DWAPlannerROS"));
+  ros::NodeHandle planner_nh("~/" + planner_namespace);
+  ros::ServiceClient client =
+      planner_nh.serviceClient<dynamic_reconfigure::Reconfigure>("set_parameters", true);
+  ros::Publisher pub = private_nh.advertise<std_msgs::String>(planner_namespace + "+x", 1);
+}
+"""
+
+
+def test_a_concatenation_of_known_strings_names_a_handle_and_a_topic() -> None:
+    files = {
+        "slow/package.xml": "<package><name>slow</name></package>\n",
+        "slow/src/slow.cpp": SLOW,
+    }
+    report = ros(files)
+    # planner_nh is "~/" + the default "DWAPlannerROS": set_parameters under /slow/DWAPlannerROS
+    client = site_at(report, "slow/src/slow.cpp", 10)  # the line of serviceClient
+    assert client.endpoint is not None
+    assert client.endpoint.key == "service:/slow/DWAPlannerROS/set_parameters"
+    # a "+" inside a string literal is no concatenation: "DWAPlannerROS" + "+x", private
+    publisher = site_at(report, "slow/src/slow.cpp", 11)
+    assert publisher.endpoint is not None
+    assert publisher.endpoint.key == "topic:/slow/DWAPlannerROS+x"
