@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import replace
 
 from archmetrics.coupling.endpoints import constants_of
-from archmetrics.coupling.matching import constructed
+from archmetrics.coupling.matching import constructed, last_name, matches, normalize_callee
 from archmetrics.coupling.model import Endpoint, LinkSite
 from archmetrics.coupling.rosnames import NodeName, UnresolvedName, resolve
 from archmetrics.coupling.rules import Role, ScopeRule
@@ -32,6 +32,8 @@ UNKNOWN_NODE = "the node's name is not known statically"
 
 # a declaration without arguments (``mover::Mover mover;``), which is no call site
 _DECLARED = re.compile(r"\s*(?:const\s+)?([A-Za-z_][\w:]*)\s+[A-Za-z_]\w*\s*;\s*")
+
+_MAKERS = frozenset({"make_shared", "make_unique"})  # std::make_shared<T>(...) makes a T
 
 PackageOf = Callable[[str], str | None]
 
@@ -83,39 +85,47 @@ def _makers(
     rules: Sequence[ScopeRule],
 ) -> dict[tuple[str, str], set[tuple[NodeName, str]]]:
     """For each (package, class) wanted, the nodes of the files making the class there,
-    each with where (``path:line``)."""
-    found: dict[tuple[str, str], set[tuple[NodeName, str]]] = {}
+    each with where (``path:line``); a file naming several nodes gives an unknown one. A
+    file is looked into only when its callees (read without decoding its call sites) name
+    a node (``ros::init``), or make a class (``std::make_shared``) and name a wanted one;
+    its declarations (``mover::Mover mover;``) only in the first case."""
+    patterns = [p for r in rules if r.kind == "node" for p in r.match]
+    naming = {normalize_callee(p).rsplit(".", 1)[-1] for p in patterns} - _MAKERS
     inside = [(path, package) for path in by_path if (package := package_of(path)) in wanted]
     visible: dict[str, set[str]] = {}  # what a package's files include (a rule's requires)
     for path, package in inside:
         visible.setdefault(str(package), set()).update(d.target for d in by_path[path].dependencies)
+    found: dict[tuple[str, str], set[tuple[NodeName, str]]] = {}
     for path, package in inside:
         facts, classes = by_path[path], wanted[str(package)]
+        callees = facts.callees()  # read without decoding the call sites
+        called = {last_name(callee) for callee in callees}
+        naming_here = any(last_name(c) in naming and any(matches(p, c) for p in patterns)
+                          for c in callees)  # ros::init, rospy.init_node, ...  # fmt: skip
+        if not naming_here and not (called & _MAKERS and called & classes):
+            continue
         made = [(cls, call.span.start) for call in facts.call_sites
-                if (cls := _last(constructed(call)[0])) in classes]  # fmt: skip
-        made += [(cls, s.span.start) for s in facts.statements if s.kind == "declaration"
+                if (call.name in classes or call.name in _MAKERS)
+                and (cls := _last(constructed(call)[0])) in classes]  # fmt: skip
+        made += [(cls, s.span.start) for s in (facts.statements if naming_here else ())
+                 if s.kind == "declaration"
                  and (declared := _DECLARED.fullmatch(s.text.replace(" :: ", "::")))
                  and (cls := _last(declared.group(1))) in classes]  # fmt: skip
-        if not made:
-            continue
-        node = _file_node(facts, rules, sorted(visible[str(package)]))
+        nodes = _file_nodes(facts, rules, sorted(visible[str(package)])) if made else set()
+        if not nodes:
+            continue  # made where no node is named: no word on its node
+        node = next(iter(nodes)) if len(nodes) == 1 else NodeName(None)  # several: unknown
         for cls, line in made:
-            key = (str(package), cls)
-            found.setdefault(key, set())
-            if node is not None:
-                found[key].add((node, f"{path}:{line}"))
-            else:
-                found[key].add((NodeName(None), path))  # made where no one node is named
+            found.setdefault((str(package), cls), set()).add((node, f"{path}:{line}"))
     return found
 
 
-def _file_node(
+def _file_nodes(
     facts: FileFacts, rules: Sequence[ScopeRule], visible: Sequence[str]
-) -> NodeName | None:
-    """The one node a file names (``ros::init(argc, argv, "move_base_node")``), if one."""
+) -> set[NodeName]:
+    """The nodes a file names (``ros::init(argc, argv, "move_base_node")``)."""
     scopes = FileScopes(facts, rules, visible, plain_reader(constants_of(facts.bindings).get))
-    named = {s.node for s in scopes.scopes if s.kind == "node" and s.node and s.node.name}
-    return named.pop() if len(named) == 1 else None
+    return {s.node for s in scopes.scopes if s.kind == "node" and s.node and s.node.name}
 
 
 def _named(
