@@ -65,6 +65,18 @@ def test_a_class_takes_the_node_of_the_program_making_it_in_its_package() -> Non
     assert "mover/src/mover_node.cpp:4" in made.note
 
 
+FACTORY = """\
+#include "mover/mover.h"
+mover::Mover * make_mover() { return new mover::Mover(); }
+"""
+
+
+def test_a_file_making_the_class_without_naming_a_node_says_nothing_of_its_node() -> None:
+    files = {"mover/src/mover_node.cpp": MAIN, "mover/src/factory.cpp": FACTORY}
+    made = site_at(ros(_mover(**files)), "mover/src/mover.cpp", 5)
+    assert made.endpoint is not None and made.endpoint.key == "topic:/mover_node/current_goal"
+
+
 def test_a_class_made_under_two_nodes_or_none_keeps_its_private_names_unresolved() -> None:
     other = MAIN.replace("mover_node", "other_node")
     report = ros(_mover(**{"mover/src/mover_node.cpp": MAIN, "mover/src/other.cpp": other}))
