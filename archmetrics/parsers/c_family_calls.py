@@ -151,13 +151,17 @@ class CallSites:
         with the byte it starts at."""
         data = self._data
         made = []
+        line, counted = 1, 0  # the line of byte ``counted``: lines are counted once, onward
         for (start, open_, close), function in zip(
             found, owners([s for s, _, _ in found]), strict=True
         ):
             name = data[start:open_].decode("utf-8", "replace").strip()
             inner = compact(data[open_ + 1 : close - 1]) if close - open_ > 2 else ""
             arguments = tuple(_macro_argument(part) for part in split_top_level(inner))
-            first = data.count(b"\n", 0, start) + 1
+            if start < counted:  # not in order (macro_calls gives them in order)
+                line, counted = 1, 0
+            line, counted = line + data.count(b"\n", counted, start), start
+            first = line
             last = first + data.count(b"\n", start, close)
             span = _new(Span, (first, last))
             site = _new(CallSite, (name, name, None, span, arguments, function, (), None))
