@@ -57,6 +57,11 @@ def _normalized(callee: str) -> tuple[str, str]:
     return name, name.rsplit(".", 1)[-1]
 
 
+def last_name(callee: str) -> str:
+    """The last part of a callee as rules see it (``init`` of ``ros::init``), kept."""
+    return _normalized(callee)[1]
+
+
 def member(text: str) -> str:
     """A name as a variable or member is compared: blanks dropped, ``this->`` left out
     (``this->pub_`` and ``pub_`` are one C++ member; ``self.pub`` stays as it is)."""

@@ -88,7 +88,7 @@ def link_tree(
         found[element.name].extend(by_file[path])
     code = {name: tuple(s) for name, s in found.items()}
     sites = with_config_sites(code, elements, by_path, rules.configuration)
-    graph = ros_graph(sites, elements, by_path)
+    graph = ros_graph(sites, elements, by_path, rules.scopes)
     return TreeLinks(elements, occurrences, graph.sites, graph.receivers, graph.applied)
 
 

@@ -29,8 +29,9 @@ from archmetrics.coupling.rosnames import (
     qualified_type,
     resolve,
 )
+from archmetrics.coupling.rosnodes import with_package_nodes
 from archmetrics.coupling.rostree import RosTree, read_tree
-from archmetrics.coupling.rules import Role
+from archmetrics.coupling.rules import Role, ScopeRule
 from archmetrics.facts import FileFacts
 
 Receivers = dict[str, frozenset[str]]
@@ -49,13 +50,16 @@ def ros_graph(
     sites: Mapping[str, tuple[LinkSite, ...]],
     elements: Sequence[Element],
     by_path: Mapping[str, FileFacts],
+    scopes: Sequence[ScopeRule] = (),
 ) -> RosGraph:
     """``sites`` (by element) with launch files, parameter files and plugin descriptions
-    applied; the receivers those add. A tree without any of it comes back as it was."""
+    applied, and a class's node named by the program making it (rosnodes.py, ``scopes``);
+    the receivers those add. A tree without any of it comes back as it was."""
     named = any(s.name or _type(s) in _CONFIGURED for found in sites.values() for s in found)
     if not named:
         return RosGraph(dict(sites), {})
     tree = read_tree(by_path)
+    sites = with_package_nodes(sites, by_path, tree.package_of, scopes)
     element_of = {path: e.name for e in elements for path in e.files}
     receivers: dict[str, set[str]] = {}
     by_launch = {(entry.path, entry.line): entry for entry in tree.launched}
@@ -215,7 +219,7 @@ def _renamed(site: LinkSite, tree: RosTree, configuration: _Configuration) -> Li
     name = (entry.name if entry and entry.name else own) or None
     where = entry.namespace if entry and entry.namespace else namespace
     node = NodeName(name, clean_namespace(where))
-    if site.parameter and node.fully_qualified:
+    if site.parameter and node.fully_qualified and not configuration.note:  # agreed, or none
         values = tree.values_for(node.fully_qualified, site.parameter)
         if entry is not None:
             values |= {v for k, v in entry.parameters if k == site.parameter}

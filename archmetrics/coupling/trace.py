@@ -113,6 +113,8 @@ class Tracer:
             traced = self._wrapped(text, function, line, DEPTH)
             if traced is None:
                 traced = self._name(text, function, line, DEPTH)
+            if traced is None and "+" in text:  # "~/" + planner_namespace
+                traced = self._sum(text, function, line)
             if traced is None and text.startswith("("):  # ("", port)
                 traced = tuple_with_names(text, lambda name: self._value(name, function, line))
         except _Ambiguous as several:
@@ -120,6 +122,31 @@ class Tracer:
         if traced is None:
             return None, via
         return traced, f"parameter:{self.parameter}" if self.parameter else "traced"
+
+    def _sum(self, text: str, function: str | None, line: int) -> Value | None:
+        """A concatenation of strings each known: ``"~/" + planner_namespace``. Literals are
+        read first, and a part that is neither a literal, a name nor a known wrapper
+        (``get_name()``) ends the reading before any name is traced."""
+        parts = _plus_parts(text)
+        if len(parts) < 2:
+            return None
+        values: list[Value | None] = [literal(part) for part in parts]
+        for part, value in zip(parts, values, strict=True):
+            if value is not None and not isinstance(value, str):
+                return None
+            wraps = self.values is not None and self.values.wrapped(part) is not None
+            if value is None and not _MEMBER.match(part) and not wraps:
+                return None
+        joined: list[str] = []
+        for part, value in zip(parts, values, strict=True):
+            if value is None:
+                value = self._wrapped(part, function, line, DEPTH)
+            if value is None:
+                value = self._value(part, function, line)
+            if not isinstance(value, str):
+                return None
+            joined.append(value)
+        return "".join(joined) or None
 
     def _value(self, name: str, function: str | None, line: int) -> Value | None:
         found = self.lookup(name)
@@ -229,7 +256,7 @@ class Tracer:
 
     def _wrapped(self, text: str, function: str | None, line: int, depth: int) -> Value | None:
         """An argument written as a call a value rule knows: ``rclcpp::ParameterValue("x")``."""
-        if self.values is None or depth <= 0 or "(" not in text:
+        if self.values is None or depth <= 0 or ("(" not in text and "{" not in text):
             return None
         found = self.values.wrapped(text)
         if found is None:
@@ -284,8 +311,6 @@ class Tracer:
         return values.pop() if values else None
 
 
-
-
 _MAKERS = frozenset({"make_shared", "make_unique"})
 
 
@@ -324,3 +349,21 @@ def _split_top_level(text: str) -> list[str]:
             current.append(char)
     parts.append("".join(current))
     return [p for p in parts if p.strip()]
+
+
+def _plus_parts(text: str) -> list[str]:
+    """``text`` split at the ``+`` outside brackets and string literals, parts stripped."""
+    parts, start, depth, at = [], 0, 0, 0
+    while at < len(text):
+        char = text[at]
+        if char in "\"'":
+            string = _STRING.match(text, at)
+            at = string.end() if string else len(text)
+            continue
+        depth += (char in "([{") - (char in ")]}")
+        if char == "+" and depth == 0:
+            parts.append(text[start:at].strip())
+            start = at + 1
+        at += 1
+    parts.append(text[start:].strip())
+    return parts
