@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import shutil
 import statistics
 import subprocess
@@ -67,7 +66,7 @@ import report
 from corpus import BenchError
 from history_table import Line, render
 from measure import Summary, repeat
-from run import _compiled
+from run import _compiled, _cores
 
 HERE = Path(__file__).resolve().parent
 STEPS = ("cold", "warm", "incremental", "dask", "wily", "memory")
@@ -393,10 +392,6 @@ def main(argv: list[str] | None = None) -> int:
     lines, failures = run(args, bench, save)
     print(save(lines, failures))
     return 1 if failures else 0
-
-
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 if __name__ == "__main__":
