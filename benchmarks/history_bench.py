@@ -12,8 +12,9 @@ a quick run; default all first-parent commits), --python-count N (wily's commits
 --synthetic N (the memory row's commits; default 40,000), --repeat N, --jobs N (parser
 processes and Dask workers; default the cores), --work FOLDER. A quick run proving every
 step works: ``--max-count 50 --repeat 1 --one-file 2``. Repositories are cloned once into the
-work folder (benchmarks/.work/history by default) and reused; every command's output is kept
-in its out/, the results in results.md and results.json. A step that fails is reported (and
+work folder (default benchmarks/.work/history-bench; .work/history is run.py's repository of
+two releases) and reused; every command's output is kept in its out/, the results in
+results.md and results.json. A step that fails is reported (and
 the script exits 1); the others still run.
 
 The choices behind each row:
@@ -363,7 +364,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=_cores(), help="parser processes, workers")
     parser.add_argument("--timeout", type=float, default=7200.0, help="seconds per run")
     parser.add_argument("--only", nargs="+", choices=STEPS, default=list(STEPS))
-    parser.add_argument("--work", type=Path, default=HERE / ".work" / "history")
+    parser.add_argument("--work", type=Path, default=HERE / ".work" / "history-bench")
     args = parser.parse_args(argv)
     _compiled()  # archmetrics's bytecode, as pip writes it (run.py says why)
     args.work = args.work.resolve()
