@@ -220,7 +220,13 @@ def incremental(bench: Bench, name: str, checkout: Callable[[], Path], wanted: i
         raise BenchError(f"{name}: no first-parent commit changes exactly one measured file")
     found = [one_step(bench, name, repo, commit) for commit in picked]
     step, step_cpu, diff, diff_cpu = (statistics.median(v) for v in zip(*found, strict=True))
-    bench.found.setdefault("step_cpu", max(step_cpu, 1e-4))
+    if step <= 0 or step_cpu <= 0:  # a difference of two whole runs: their noise can win
+        steps = ", ".join(f"{f[0]:.3f}" for f in found)
+        raise BenchError(
+            f"{name}: a one-file step is below the noise of two whole runs (steps, wall s: "
+            f"{steps}; CPU median {step_cpu:.3f} s): run again with --repeat 5 or more"
+        )
+    bench.found.setdefault("step_cpu", step_cpu)
     measure = f"one-file commit's step in a warm history, {name} ({len(picked)} commits)"
     ours = f"{step:.3f} / {step_cpu:.3f} s"
     peer = f"diff C^..C warm: {diff:.3f} / {diff_cpu:.3f} s"
