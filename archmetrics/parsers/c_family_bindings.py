@@ -34,7 +34,7 @@ _ASSIGNED = frozenset({"identifier", "field_expression"})  # x = ..., this->x = 
 _ONE_TOKEN = _NAMES | {"type_identifier"}
 
 
-def _declared(declarator: Node | None) -> Node | None:
+def declared(declarator: Node | None) -> Node | None:
     """The identifier a declarator declares, through the declarators that wrap it."""
     for _ in range(64):  # ``int *(*(*p))`` nests, but never this deep in real code
         if declarator is None or declarator.type in _NAMES:
@@ -74,7 +74,7 @@ def _parts(node: Node) -> tuple[Node | None, Node | None]:
         value = node.child_by_field_name("value" if kind[0] == "i" else "default_value")
         if value is None or value.type in _NOT_ASSIGNED:
             return None, None
-        return _declared(node.child_by_field_name("declarator")), value
+        return declared(node.child_by_field_name("declarator")), value
     operator = node.child_by_field_name("operator")
     if operator is None or operator.type != "=":
         return None, None

@@ -16,28 +16,13 @@ from collections.abc import Iterable
 
 from tree_sitter import Node
 
+from archmetrics.parsers.c_family_bindings import declared
 from archmetrics.parsers.c_family_calls import Construction  # where, class, arguments, target
 from archmetrics.parsers.c_family_names import text
 from archmetrics.parsers.c_family_text import compact
 
 _ARGUMENTS = frozenset({"argument_list", "initializer_list"})
-_NAMES = frozenset({"identifier", "field_identifier"})
-_WRAPPERS = frozenset(
-    {"pointer_declarator", "array_declarator", "reference_declarator", "parenthesized_declarator"}
-)
 _LONGEST = 400  # bytes of a target or a type read: names, not expressions
-
-
-def _declared(declarator: Node | None) -> Node | None:
-    """The identifier a declarator declares, through the declarators that wrap it."""
-    for _ in range(64):
-        if declarator is None or declarator.type in _NAMES:
-            return declarator
-        if declarator.type not in _WRAPPERS:
-            return None
-        inner = declarator.child_by_field_name("declarator")
-        declarator = inner if inner is not None else declarator.named_child(0)
-    return None
 
 
 def _short(node: Node, data: bytes) -> str | None:
@@ -99,7 +84,7 @@ def _assignment(node: Node) -> tuple[Node | None, Node | None]:
         value = node.child_by_field_name("value")
         if value is None or value.type not in _VALUES:
             return None, None
-        return _declared(node.child_by_field_name("declarator")), value
+        return declared(node.child_by_field_name("declarator")), value
     if kind == "assignment_expression":
         right = node.child_by_field_name("right")
         if right is None or right.type not in _VALUES:
@@ -213,7 +198,7 @@ def constructions(
             if declarator is None or declarator.type != "init_declarator":
                 continue
             value = declarator.child_by_field_name("value")
-            name = _declared(declarator.child_by_field_name("declarator"))
+            name = declared(declarator.child_by_field_name("declarator"))
             if value is not None and value.type in _ARGUMENTS and name is not None:
                 found.append((declarator, written, value, _short(name, data)))
         return found
